@@ -1,0 +1,67 @@
+"""plateimpact: oblique impact of rigid spheres on plates (after NWC TP 5844).
+
+The public API, for study scripts and plug-in authors. SI units throughout; see
+:mod:`plateimpact.units` for mm, g and degrees.
+"""
+
+from __future__ import annotations
+
+from importlib.metadata import PackageNotFoundError, version
+
+from . import geometry, presets, units
+from .batch import SceneBatch
+from .bodies import Plate, Sphere
+from .errors import (
+    IntegrationError,
+    ParameterError,
+    PlateImpactError,
+    UnknownNameError,
+)
+from .failure import FailureModel
+from .geometry import contact_geometry, contact_lost_margin, force_inclination
+from .hookspecs import hookimpl
+from .integrator import Integrator, ResultRecorder
+from .model import ImpactModel
+from .registry import PluginRegistry, default_registry, load_registry
+from .resistance import ResistanceLaw, contact_force
+from .results import BatchResult, Outcome, Result, Trajectory
+from .scene import Scene
+from .simulation import Simulation, run
+
+try:
+    __version__ = version("plateimpact")
+except PackageNotFoundError:  # running from a source tree
+    __version__ = "0+unknown"
+
+__all__ = [
+    "BatchResult",
+    "FailureModel",
+    "ImpactModel",
+    "IntegrationError",
+    "Integrator",
+    "Outcome",
+    "ParameterError",
+    "Plate",
+    "PlateImpactError",
+    "PluginRegistry",
+    "ResistanceLaw",
+    "Result",
+    "ResultRecorder",
+    "Scene",
+    "SceneBatch",
+    "Simulation",
+    "Sphere",
+    "Trajectory",
+    "UnknownNameError",
+    "contact_force",
+    "contact_geometry",
+    "contact_lost_margin",
+    "default_registry",
+    "force_inclination",
+    "geometry",
+    "hookimpl",
+    "load_registry",
+    "presets",
+    "run",
+    "units",
+]

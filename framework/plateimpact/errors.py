@@ -1,0 +1,34 @@
+"""Exceptions raised at the user's edge.
+
+Every error a user can cause by input is a :class:`PlateImpactError`; its message is one
+line that names the parameter and the allowed range, so the command line can print it
+as it is (exit code 2, no traceback).
+"""
+
+from __future__ import annotations
+
+
+class PlateImpactError(Exception):
+    """Base class of the errors caused by input (bad parameters, unknown names)."""
+
+
+class ParameterError(PlateImpactError, ValueError):
+    """A parameter is outside its allowed range.
+
+    Attributes
+    ----------
+    parameter : str
+        The name of the parameter, as the Python API spells it (``impact_obliquity``).
+    """
+
+    def __init__(self, parameter: str, message: str) -> None:
+        super().__init__(message)
+        self.parameter = parameter
+
+
+class UnknownNameError(PlateImpactError, LookupError):
+    """A plug-in (resistance law, failure model, integrator) or preset name is unknown."""
+
+
+class IntegrationError(PlateImpactError, RuntimeError):
+    """An integrator could not bring every scene of a batch to an outcome."""

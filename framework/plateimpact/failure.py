@@ -1,0 +1,62 @@
+"""The FailureModel interface: when the plate fails and what failure changes."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import ClassVar
+
+import numpy as np
+
+from .batch import SceneBatch
+from .resistance import ResistanceLaw
+
+
+class FailureModel(ABC):
+    """When the plate fails, and how the force on the sphere changes once it has.
+
+    The core calls the methods below with arrays over the scenes of a batch:
+
+    * :meth:`onset_penetration` once per batch: the penetration at which failure starts
+      (P* in the report; ``inf`` for a plate that never fails). Failure is an event: it
+      starts when P first reaches this value and lasts for the rest of the impact.
+    * :meth:`force_change` at every step, **only for scenes whose plate has failed**:
+      what failure adds to the intact force F* (the plugging relief is −F′, eq 15).
+    * :meth:`perforation_margin`, likewise only for failed scenes: >= 0 once the sphere
+      has passed the material that still resists, which ends the impact in perforation.
+
+    Subclass, set ``name``, implement the three methods in numpy, and register the class
+    from a ``plateimpact_register`` hook. Per-scene constants that do not change during
+    the impact belong in :meth:`prepare`, which runs once per batch.
+    """
+
+    name: ClassVar[str]
+    version: ClassVar[str] = "1"
+
+    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
+        """Per-scene columns to compute once per batch (default none)."""
+        return {}
+
+    @abstractmethod
+    def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
+        """Penetration at which the plate fails [m], per scene; ``inf`` for never."""
+
+    @abstractmethod
+    def force_change(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        batch: SceneBatch,
+        law: ResistanceLaw,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Drag and lift [N] that failure adds to the intact force (negative: relief)."""
+
+    @abstractmethod
+    def perforation_margin(
+        self, penetration: np.ndarray, obliquity: np.ndarray, batch: SceneBatch
+    ) -> np.ndarray:
+        """A length [m] that crosses zero upward when perforation is complete."""
+
+    def settings(self) -> dict[str, object]:
+        """The plug-in's settings, for archives (default: none)."""
+        return {}

@@ -1,0 +1,128 @@
+"""ImpactModel: the resolved model slots, and the force and event rules all integrators share."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import attrs
+import numpy as np
+
+from . import validation as v
+from .batch import SceneBatch
+from .failure import FailureModel
+from .geometry import contact_lost_margin
+from .resistance import ResistanceLaw, contact_force
+from .results import Outcome
+
+REST_SPEED_FRACTION = v.Range(0.0, 1.0, True, True)
+
+
+@attrs.frozen
+class ImpactModel:
+    """A resistance law and a failure model, resolved once, used on whole batches.
+
+    Parameters
+    ----------
+    resistance : ResistanceLaw
+    failure : FailureModel
+    rest_speed_fraction : float
+        The embedment rule (docs/model.md, "rest"): a sphere is at rest when its speed
+        falls to this fraction of its impact speed; its exit obliquity is its direction
+        then. In (0, 1); default 0.01.
+    """
+
+    resistance: ResistanceLaw = attrs.field(validator=attrs.validators.instance_of(ResistanceLaw))
+    failure: FailureModel = attrs.field(validator=attrs.validators.instance_of(FailureModel))
+    rest_speed_fraction: float = REST_SPEED_FRACTION.field(default=1e-2)
+
+    #: Obliquity is held here once reached (model-notes §4): straight back out [rad].
+    MAX_OBLIQUITY: ClassVar[float] = np.pi
+
+    def bind(self, batch: SceneBatch) -> SceneBatch:
+        """The batch with every per-scene constant the step loop needs, computed once:
+        ``onset_penetration`` [m], ``rest_speed`` [m/s] and the plug-ins' own columns."""
+        extra = {**self.resistance.prepare(batch), **self.failure.prepare(batch)}
+        onset = np.asarray(self.failure.onset_penetration(batch), dtype=float)
+        v.CRITICAL_PENETRATION.check("onset_penetration", onset)
+        return batch.with_columns(
+            onset_penetration=onset,
+            rest_speed=self.rest_speed_fraction * batch.impact_speed,
+            **extra,
+        )
+
+    def forces(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        failed: np.ndarray,
+        batch: SceneBatch,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Net drag and lift [N] on every scene (eqs 1, 15, 22–24).
+
+        The failure model is consulted only for the scenes whose plate has failed.
+        """
+        drag, lift = contact_force(self.resistance, penetration, obliquity, speed, batch)
+        if failed.any():
+            index = np.flatnonzero(failed)
+            extra_drag, extra_lift = self.failure.force_change(
+                penetration[index],
+                obliquity[index],
+                speed[index],
+                batch.take(index),
+                self.resistance,
+            )
+            drag[index] += extra_drag
+            lift[index] += extra_lift
+        return drag, lift
+
+    def perforation_margin(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        failed: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        """>= 0 where perforation is complete [m]; −inf where the plate is intact."""
+        margin = np.full(penetration.shape, -np.inf)
+        if failed.any():
+            index = np.flatnonzero(failed)
+            margin[index] = self.failure.perforation_margin(
+                penetration[index], obliquity[index], batch.take(index)
+            )
+        return margin
+
+    def classify(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        failed: np.ndarray,
+        at_rest: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        """Outcome code per scene after a step: 0 while the impact goes on.
+
+        Perforation (front layer passed while moving inward) takes precedence over
+        ricochet (contact lost), which takes precedence over embedment (rest).
+        """
+        status = np.zeros(penetration.shape, dtype=np.int8)
+        status[at_rest] = Outcome.EMBEDMENT
+        lost = contact_lost_margin(penetration, obliquity, batch.radius) >= 0.0
+        status[lost] = Outcome.RICOCHET
+        perforated = (obliquity < 0.5 * np.pi) & (
+            self.perforation_margin(penetration, obliquity, failed, batch) >= 0.0
+        )
+        status[perforated] = Outcome.PERFORATION
+        return status
+
+    def describe(self) -> dict[str, object]:
+        """Plug-in names, versions and settings, for output and archives."""
+        return {
+            "resistance": self.resistance.name,
+            "resistance_version": self.resistance.version,
+            "resistance_settings": self.resistance.settings(),
+            "failure": self.failure.name,
+            "failure_version": self.failure.version,
+            "failure_settings": self.failure.settings(),
+            "rest_speed_fraction": self.rest_speed_fraction,
+        }

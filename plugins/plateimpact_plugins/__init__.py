@@ -1,0 +1,23 @@
+"""The built-in plug-ins of plateimpact.
+
+This package uses only plateimpact's public API and registers through the
+``plateimpact`` entry-point group, exactly as a third-party plug-in package does.
+"""
+
+from __future__ import annotations
+
+from plateimpact import PluginRegistry, hookimpl
+
+from .intact import Intact
+from .plugging import Plugging
+from .poncelet import Poncelet
+from .segment import Segment
+
+__all__ = ["Intact", "Plugging", "Poncelet", "Segment", "plateimpact_register"]
+
+
+@hookimpl
+def plateimpact_register(registry: PluginRegistry) -> None:
+    """Register the built-in resistance law, failure models and integrators."""
+    for cls in (Poncelet, Plugging, Intact, Segment):
+        registry.add(cls)
