@@ -1,0 +1,347 @@
+"""The ``plateimpact`` command: user units (mm, m/s, g, degrees) in and out.
+
+Every input error prints one line, ``plateimpact: error: ...``, and exits with code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import os
+import sys
+import tempfile
+from collections.abc import Sequence
+from typing import Any, NoReturn
+
+import attrs
+import numpy as np
+
+from . import presets
+from .batch import SceneBatch
+from .bodies import Plate, Sphere
+from .errors import ParameterError, PlateImpactError
+from .results import Outcome
+from .scene import Scene
+from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from .units import deg, g, mm
+
+#: Which flag carries which parameter, so that an error names what the user typed.
+FLAG_OF = {
+    "impact_speed": "--speed",
+    "impact_obliquity": "--obliquity",
+    "thickness": "--thickness",
+    "a": "--a",
+    "b": "--b",
+    "critical_penetration": "--pstar",
+    "failure_angle": "--alpha",
+    "radius": "--radius",
+    "mass": "--mass",
+    "step": "--step",
+}
+
+SWEEP_COLUMNS = (
+    "preset",
+    "impact_speed_m_s",
+    "impact_obliquity_deg",
+    "outcome",
+    "exit_speed_m_s",
+    "exit_obliquity_deg",
+    "contact_time_s",
+    "max_penetration_mm",
+    "plate_failed",
+)
+
+
+class UsageError(PlateImpactError):
+    """A command-line argument is malformed."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:  # one line, exit 2, no usage dump
+        self.exit(2, f"plateimpact: error: {message}\n")
+
+
+def _add_model_options(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("model (plug-ins by name; see 'plateimpact plugins')")
+    group.add_argument("--resistance", default=DEFAULT_RESISTANCE, help="resistance law")
+    group.add_argument("--failure", default=DEFAULT_FAILURE, help="failure model")
+    group.add_argument("--integrator", default=DEFAULT_INTEGRATOR, help="integrator")
+    group.add_argument(
+        "--step",
+        type=float,
+        help="integrator step; for 'segment', the segment duration as a fraction of "
+        "Rs/Vs (default 1e-3, finest documented 1e-4)",
+    )
+
+
+def _add_body_options(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("plate and sphere (override the preset)")
+    group.add_argument("--preset", help=f"plate preset: {', '.join(presets.PLATES)}")
+    group.add_argument("--thickness", type=float, help="plate thickness T [mm]")
+    group.add_argument("--a", type=float, help="Poncelet strength term a [N/m^2]")
+    group.add_argument("--b", type=float, help="Poncelet inertial term b [kg/m^3]")
+    group.add_argument("--pstar", type=float, help="critical penetration P* [mm] (inf: never)")
+    group.add_argument("--alpha", type=float, help="failure angle alpha* [deg]")
+    group.add_argument("--radius", type=float, help="sphere radius Rs [mm] (default 3.175)")
+    group.add_argument("--mass", type=float, help="sphere mass m [g] (default 1.0498)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``plateimpact`` command."""
+    parser = _Parser(prog="plateimpact", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("presets", help="list the plate presets and the default sphere")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+    sub.add_parser("plugins", help="list the installed plug-ins by kind")
+
+    p = sub.add_parser("run", help="run one scene")
+    p.add_argument("--speed", type=float, required=True, help="impact speed [m/s]")
+    p.add_argument("--obliquity", type=float, required=True, help="impact obliquity [deg]")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--trajectory", metavar="FILE", help="write the trajectory as CSV")
+    _add_body_options(p)
+    _add_model_options(p)
+
+    p = sub.add_parser("sweep", help="run a grid of speeds and obliquities")
+    p.add_argument(
+        "--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a comma list"
+    )
+    p.add_argument("--obliquities", required=True, help="impact obliquities [deg], a comma list")
+    p.add_argument("--csv", metavar="FILE", help="write CSV here (default: standard output)")
+    _add_body_options(p)
+    _add_model_options(p)
+    return parser
+
+
+def _bodies(args: argparse.Namespace) -> tuple[Sphere, Plate, str]:
+    plate_flags = ("thickness", "a", "b", "pstar", "alpha")
+    if args.preset is None:
+        missing = [f"--{f}" for f in plate_flags if getattr(args, f) is None]
+        if missing:
+            raise UsageError(
+                "--preset is required unless all plate options are given "
+                f"(missing {', '.join(missing)})"
+            )
+        base, label = None, "custom"
+    else:
+        base, label = presets.plate(args.preset), args.preset
+    overrides: dict[str, Any] = {}
+    for flag, field, unit in (
+        ("thickness", "thickness", mm),
+        ("a", "a", 1.0),
+        ("b", "b", 1.0),
+        ("pstar", "critical_penetration", mm),
+        ("alpha", "failure_angle", deg),
+    ):
+        if getattr(args, flag) is not None:
+            overrides[field] = getattr(args, flag) * unit
+    if base is None:
+        plate = Plate(material="custom", **overrides)
+    else:
+        plate = attrs.evolve(base, **overrides) if overrides else base
+        if overrides:
+            label = f"{label}+custom"
+    sphere = presets.DEFAULT_SPHERE
+    if args.radius is not None or args.mass is not None:
+        radius = args.radius * mm if args.radius is not None else sphere.radius
+        if args.mass is not None:
+            sphere = Sphere(radius=radius, mass=args.mass * g)
+        else:  # a new radius keeps the default sphere's density
+            sphere = Sphere.of_density(radius, presets.SAE_52100_DENSITY)
+    return sphere, plate, label
+
+
+def _simulation(args: argparse.Namespace) -> Simulation:
+    settings = {} if args.step is None else {"step": args.step}
+    return Simulation.from_names(
+        args.resistance, args.failure, args.integrator, integrator_settings=settings
+    )
+
+
+def _parse_speeds(text: str) -> np.ndarray:
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if n < 1:
+                raise ValueError
+            return np.linspace(float(start), float(stop), n)
+        return np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        raise UsageError(
+            f"--speeds must be START:STOP:N (N >= 1) or a comma list in m/s, got {text!r}"
+        ) from None
+
+
+def _parse_obliquities(text: str) -> np.ndarray:
+    try:
+        return np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        raise UsageError(f"--obliquities must be a comma list in degrees, got {text!r}") from None
+
+
+def _write_atomically(path: str, text: str, flag: str) -> None:
+    """Write ``text`` to ``path`` so that no partial file is ever left behind."""
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise UsageError(f"{flag}: directory {directory!r} does not exist")
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", newline="") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _cmd_presets(args: argparse.Namespace) -> None:
+    sphere = presets.DEFAULT_SPHERE
+    rows = {
+        name: {
+            "material": p.material,
+            "thickness_mm": p.thickness / mm,
+            "pstar_mm": p.critical_penetration / mm,
+            "alpha_deg": round(p.failure_angle / deg, 9),
+            "a_N_m2": p.a,
+            "b_kg_m3": p.b,
+        }
+        for name, p in presets.PLATES.items()
+    }
+    sphere_row = {
+        "material": "SAE 52100",
+        "radius_mm": sphere.radius / mm,
+        "mass_g": sphere.mass / g,
+        "density_kg_m3": presets.SAE_52100_DENSITY,
+    }
+    if args.json:
+        print(json.dumps({"plates": rows, "sphere": sphere_row}, indent=2))
+        return
+    print(
+        f"{'plate':14s} {'material':9s} {'T mm':>6s} {'P* mm':>6s} {'a* deg':>6s} "
+        f"{'a N/m^2':>10s} {'b kg/m^3':>9s}"
+    )
+    for name, r in rows.items():
+        print(
+            f"{name:14s} {r['material']:9s} {r['thickness_mm']:6.2f} {r['pstar_mm']:6.2f} "
+            f"{r['alpha_deg']:6.1f} {r['a_N_m2']:10.4g} {r['b_kg_m3']:9.4g}"
+        )
+    print(
+        f"\nsphere (default): SAE 52100, radius {sphere_row['radius_mm']:.4g} mm, "
+        f"mass {sphere_row['mass_g']:.4f} g, density {sphere_row['density_kg_m3']:.0f} kg/m^3"
+    )
+
+
+def _cmd_plugins(args: argparse.Namespace) -> None:
+    from .registry import KINDS, default_registry
+
+    registry = default_registry()
+    for kind in KINDS:
+        print(f"{kind}: {', '.join(registry.names(kind))}")
+
+
+def _cmd_run(args: argparse.Namespace) -> None:
+    sphere, plate, label = _bodies(args)
+    scene = Scene(sphere, plate, args.speed, args.obliquity * deg)
+    simulation = _simulation(args)
+    result = simulation.run(scene, record_trajectory=args.trajectory is not None)
+    if args.trajectory is not None:
+        t = result.trajectory
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        writer.writerow(["time_s", "penetration_mm", "lateral_mm", "obliquity_deg", "speed_m_s"])
+        for row in zip(
+            t.time, t.penetration / mm, t.lateral / mm, t.obliquity / deg, t.speed, strict=True
+        ):
+            writer.writerow([repr(float(x)) for x in row])
+        _write_atomically(args.trajectory, buffer.getvalue(), "--trajectory")
+    out = {"preset": label, "impact_speed_m_s": args.speed, "impact_obliquity_deg": args.obliquity}
+    out.update(result.as_user_dict())
+    out["model"] = simulation.describe()
+    if args.json:
+        print(json.dumps(out))
+        return
+    print(f"{label}: {args.speed:g} m/s at {args.obliquity:g} deg -> {result.outcome.label}")
+    print(f"  exit speed       {result.exit_speed:.6g} m/s")
+    print(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
+    print(f"  contact time     {result.contact_time * 1e6:.6g} us")
+    print(f"  max penetration  {result.max_penetration / mm:.6g} mm")
+    if result.plate_failed:
+        print(
+            f"  plate failed     at P = {result.failure_penetration / mm:.6g} mm, "
+            f"Y = {result.failure_lateral / mm:.6g} mm, t = {result.failure_time * 1e6:.6g} us"
+        )
+    else:
+        print("  plate failed     no")
+
+
+def _cmd_sweep(args: argparse.Namespace) -> None:
+    sphere, plate, label = _bodies(args)
+    speeds, obliquities = _parse_speeds(args.speeds), _parse_obliquities(args.obliquities)
+    batch = SceneBatch.grid(sphere, plate, speeds, obliquities * deg)
+    result = _simulation(args).run_batch(batch)
+    # Echo the values as typed (the grid is obliquity-major), not their round trip via SI.
+    typed_obliquity = np.repeat(obliquities, speeds.size)
+    typed_speed = np.tile(speeds, obliquities.size)
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(SWEEP_COLUMNS)
+    for i in range(len(result)):
+        writer.writerow(
+            [
+                label,
+                repr(float(typed_speed[i])),
+                repr(float(typed_obliquity[i])),
+                Outcome(int(result.outcome[i])).label,
+                repr(float(result.exit_speed[i])),
+                repr(float(result.exit_obliquity[i] / deg)),
+                repr(float(result.contact_time[i])),
+                repr(float(result.max_penetration[i] / mm)),
+                str(bool(result.plate_failed[i])).lower(),
+            ]
+        )
+    if args.csv is None:
+        sys.stdout.write(buffer.getvalue())
+    else:
+        _write_atomically(args.csv, buffer.getvalue(), "--csv")
+        counts = np.bincount(result.outcome, minlength=4)
+        print(
+            f"wrote {len(result)} scenes to {args.csv}: "
+            + ", ".join(f"{counts[o]} {o.label}" for o in Outcome)
+        )
+
+
+COMMANDS = {
+    "presets": _cmd_presets,
+    "plugins": _cmd_plugins,
+    "run": _cmd_run,
+    "sweep": _cmd_sweep,
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``plateimpact`` command; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        COMMANDS[args.command](args)
+    except ParameterError as exc:
+        flag = FLAG_OF.get(exc.parameter)
+        prefix = f"{flag}: " if flag else ""
+        print(f"plateimpact: error: {prefix}{exc}", file=sys.stderr)
+        return 2
+    except PlateImpactError as exc:
+        print(f"plateimpact: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # e.g. piped into head
+        sys.stderr.close()
+        return 0
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
