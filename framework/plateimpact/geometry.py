@@ -71,7 +71,9 @@ def force_inclination(
             first * np.sin(b1) + second * np.sin(second_normal),
             first * np.cos(b1) + second * np.cos(second_normal),
         )
-        phi[ring] = np.where(ring_phi < 0.0, ring_phi + TWO_PI, ring_phi)
+        # φ <= θ holds analytically (the longer arc lies behind the path); the clip only
+        # removes arctan2 round-off near θ = π, where the two chords nearly cancel.
+        phi[ring] = np.minimum(np.where(ring_phi < 0.0, ring_phi + TWO_PI, ring_phi), th)
     return phi
 
 
