@@ -49,7 +49,9 @@ def test_thin_plate_ricochets_after_failure_just_below_embedment():
     intact = ricochet & ~result.plate_failed
     assert band.sum() >= 2
     # Order along the speed axis: intact ricochets, the band, then no more ricochets.
-    kinds = "".join("b" if f else "i" if r else c for f, r, c in zip(band, intact, letters(result)))
+    kinds = "".join(
+        "b" if f else "i" if r else c for f, r, c in zip(band, intact, letters(result), strict=True)
+    )
     assert re.fullmatch("i+b+E+P+", kinds), kinds
     band_speed, band_obliquity = result.exit_speed[band], result.exit_obliquity[band]
     assert np.all(np.diff(band_speed) < 0.0) and np.all(np.diff(band_obliquity) > 0.0)
