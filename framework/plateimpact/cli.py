@@ -184,11 +184,18 @@ def _parse_obliquities(text: str) -> np.ndarray:
         raise UsageError(f"--obliquities must be a comma list in degrees, got {text!r}") from None
 
 
+def _check_directory(path: str | None, flag: str) -> None:
+    """Refuse an output path in a missing directory before any work is done."""
+    if path is not None and not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+        raise UsageError(
+            f"{flag}: directory {os.path.dirname(os.path.abspath(path))!r} does not exist"
+        )
+
+
 def _write_atomically(path: str, text: str, flag: str) -> None:
     """Write ``text`` to ``path`` so that no partial file is ever left behind."""
+    _check_directory(path, flag)
     directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise UsageError(f"{flag}: directory {directory!r} does not exist")
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".tmp")
     try:
         with os.fdopen(fd, "w", newline="") as handle:
@@ -246,6 +253,7 @@ def _cmd_plugins(args: argparse.Namespace) -> None:
 
 
 def _cmd_run(args: argparse.Namespace) -> None:
+    _check_directory(args.trajectory, "--trajectory")
     sphere, plate, label = _bodies(args)
     scene = Scene(sphere, plate, args.speed, args.obliquity * deg)
     simulation = _simulation(args)
@@ -281,6 +289,7 @@ def _cmd_run(args: argparse.Namespace) -> None:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> None:
+    _check_directory(args.csv, "--csv")
     sphere, plate, label = _bodies(args)
     speeds, obliquities = _parse_speeds(args.speeds), _parse_obliquities(args.obliquities)
     batch = SceneBatch.grid(sphere, plate, speeds, obliquities * deg)

@@ -1,0 +1,175 @@
+"""The plateimpact command: outputs in user units, one-line errors with exit code 2."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import subprocess
+import sys
+
+import pytest
+
+from plateimpact import presets
+from plateimpact.cli import SWEEP_COLUMNS, main
+
+RUN = ["run", "--preset", "2024-T3/6.35", "--speed", "500", "--obliquity", "30"]
+
+
+def test_presets_lists_table_1(capsys):
+    assert main(["presets", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert set(listed["plates"]) == set(presets.PLATES)
+    assert listed["plates"]["SAE1010/1.47"]["pstar_mm"] == pytest.approx(4.6)
+    assert listed["sphere"]["mass_g"] == pytest.approx(1.0497, abs=1e-4)
+    assert main(["presets"]) == 0 and "6061-T6/9.53" in capsys.readouterr().out
+
+
+def test_run_json_has_the_documented_fields(capsys):
+    assert main([*RUN, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["outcome"] in {"ricochet", "embedment", "perforation"}
+    for key in ("exit_speed_m_s", "exit_obliquity_deg", "contact_time_s", "max_penetration_mm"):
+        assert isinstance(out[key], float)
+    assert isinstance(out["plate_failed"], bool)
+    assert out["model"]["integrator"] == "segment"
+
+
+def test_run_overrides_match_the_python_api(capsys):
+    # A custom plate equal to the preset gives the preset's answer.
+    p = presets.plate("2024-T3/6.35")
+    custom = [
+        "run",
+        "--speed",
+        "500",
+        "--obliquity",
+        "30",
+        "--thickness",
+        "6.35",
+        "--a",
+        repr(p.a),
+        "--b",
+        repr(p.b),
+        "--pstar",
+        "6.4",
+        "--alpha",
+        "45",
+        "--json",
+    ]
+    main(custom)
+    main([*RUN, "--json"])
+    first, second = (json.loads(line) for line in capsys.readouterr().out.splitlines())
+    assert first["exit_speed_m_s"] == pytest.approx(second["exit_speed_m_s"], rel=1e-12)
+
+
+def test_run_writes_a_trajectory(tmp_path, capsys):
+    target = tmp_path / "path.csv"
+    assert main([*RUN, "--trajectory", str(target)]) == 0
+    rows = list(csv.DictReader(target.open()))
+    assert rows[0]["penetration_mm"] == "0.0" and float(rows[0]["obliquity_deg"]) == pytest.approx(
+        30
+    )
+    assert len(rows) > 100
+
+
+def test_sweep_writes_one_row_per_scene(tmp_path, capsys):
+    args = [
+        "sweep",
+        "--preset",
+        "SAE1010/1.47",
+        "--speeds",
+        "100:1000:4",
+        "--obliquities",
+        "0,60",
+        "--step",
+        "4e-3",
+    ]
+    assert main(args) == 0
+    rows = list(csv.reader(io.StringIO(capsys.readouterr().out)))
+    assert tuple(rows[0]) == SWEEP_COLUMNS and len(rows) == 1 + 8
+    assert [r[2] for r in rows[1:]] == ["0.0"] * 4 + ["60.0"] * 4
+    target = tmp_path / "sweep.csv"
+    assert main([*args[:4], "100,400", *args[5:], "--csv", str(target)]) == 0
+    assert len(target.read_text().splitlines()) == 1 + 4
+    assert "wrote 4 scenes" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (["--speed", "-5"], "--speed"),
+        (["--speed", "nan"], "--speed"),
+        (["--speed", "0"], "--speed"),
+        (["--obliquity", "90"], "--obliquity"),
+        (["--obliquity", "-1"], "--obliquity"),
+        (["--preset", "nope"], "unknown preset"),
+        (["--pstar", "0"], "--pstar"),
+        (["--pstar", "-2"], "--pstar"),
+        (["--alpha", "0"], "--alpha"),
+        (["--alpha", "95"], "--alpha"),
+        (["--thickness", "0"], "--thickness"),
+        (["--radius", "-1"], "--radius"),
+        (["--mass", "0"], "--mass"),
+        (["--a", "0"], "--a"),
+        (["--integrator", "rk99"], "unknown integrator"),
+        (["--failure", "shatter"], "unknown failure"),
+        (["--step", "1"], "step"),
+    ],
+)
+def test_run_bad_input_is_one_line_and_exit_2(args, named, capsys):
+    code = main([*RUN, *args])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("plateimpact: error: ") and named in err
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["run", "--preset", "2024-T3/6.35", "--speed", "fast", "--obliquity", "0"],
+        ["run", "--speed", "100"],
+        ["sweep", "--preset", "2024-T3/6.35", "--speeds", "1:2", "--obliquities", "0"],
+        ["sweep", "--preset", "2024-T3/6.35", "--speeds", "100", "--obliquities", "x"],
+        ["frobnicate"],
+    ],
+)
+def test_malformed_arguments_are_one_line_and_exit_2(args, capsys):
+    with pytest.raises(SystemExit) as info:
+        code = main(args)
+        raise SystemExit(code)
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("plateimpact: error: ")
+
+
+def test_custom_plate_needs_every_plate_option(capsys):
+    assert main(["run", "--speed", "100", "--obliquity", "0", "--a", "1e9"]) == 2
+    assert "missing --thickness, --b, --pstar, --alpha" in capsys.readouterr().err
+
+
+def test_csv_into_a_missing_directory_is_refused_before_any_write(tmp_path, capsys):
+    code = main(
+        [
+            "sweep",
+            "--preset",
+            "2024-T3/6.35",
+            "--speeds",
+            "100",
+            "--obliquities",
+            "0",
+            "--csv",
+            str(tmp_path / "missing" / "out.csv"),
+        ]
+    )
+    assert code == 2 and "does not exist" in capsys.readouterr().err
+    assert not (tmp_path / "missing").exists()
+
+
+def test_installed_command_exits_2_without_traceback():
+    done = subprocess.run(
+        [sys.executable, "-m", "plateimpact.cli", *RUN[:-1], "95"], capture_output=True, text=True
+    )
+    assert done.returncode == 2
+    assert done.stderr == (
+        "plateimpact: error: --obliquity: impact_obliquity must be in [0, 90) deg, got 95 deg\n"
+    )

@@ -1,0 +1,117 @@
+"""Plug-in discovery: built-ins and third-party packages through the same entry-point group."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import json
+import os
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pluggy
+import pytest
+
+import plateimpact as pi
+from plateimpact import presets
+
+ROOT = Path(__file__).resolve().parents[1]
+THIRD_PARTY = Path(__file__).resolve().parent / "third_party"
+
+
+@pytest.fixture
+def with_third_party(monkeypatch):
+    monkeypatch.syspath_prepend(str(THIRD_PARTY))
+    importlib.invalidate_caches()
+
+
+def test_builtins_arrive_only_through_the_entry_point_group():
+    assert pi.load_registry(entry_points=False).names("resistance") == []
+    registry = pi.load_registry()
+    assert {"poncelet"} <= set(registry.names("resistance"))
+    assert {"plugging", "intact"} <= set(registry.names("failure"))
+    assert {"segment"} <= set(registry.names("integrator"))
+
+
+def test_third_party_package_is_used_by_name(with_third_party, sphere):
+    registry = pi.load_registry()
+    assert "isotropic-poncelet" in registry.names("resistance")
+    plate = presets.plate("6061-T6/9.53")
+    results = {}
+    for law in ("poncelet", "isotropic-poncelet"):
+        simulation = pi.Simulation.from_names(
+            resistance=law, integrator_settings={"step": 2e-3}, registry=registry
+        )
+        results[law] = simulation.run_batch(
+            [pi.Scene(sphere, plate, 400.0, 0.0), pi.Scene(sphere, plate, 400.0, np.radians(45))]
+        )
+    # At normal incidence ψ ≡ 0, so both laws are eq 1 exactly; at 45° the isotropic
+    # law resists more (no cos²ψ reduction): the ricochet is shallower and shorter.
+    a, b = results["poncelet"], results["isotropic-poncelet"]
+    assert a.max_penetration[0] == b.max_penetration[0]
+    assert b.outcome[1] == a.outcome[1] == pi.Outcome.RICOCHET
+    assert b.max_penetration[1] < a.max_penetration[1]
+    assert b.contact_time[1] < a.contact_time[1]
+
+
+def test_third_party_package_works_from_the_command_line(sphere):
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(THIRD_PARTY), *sys.path])}
+    command = [
+        sys.executable,
+        "-m",
+        "plateimpact.cli",
+        "run",
+        "--preset",
+        "2024-T3/6.35",
+        "--speed",
+        "500",
+        "--obliquity",
+        "30",
+        "--resistance",
+        "isotropic-poncelet",
+        "--json",
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, env=env, check=True)
+    assert json.loads(done.stdout)["model"]["resistance"] == "isotropic-poncelet"
+
+
+def test_misspelled_hook_is_rejected():
+    hookimpl = pluggy.HookimplMarker("plateimpact")
+    plugin = types.SimpleNamespace(plateimpact_regster=hookimpl(lambda registry: None))
+    with pytest.raises(pluggy.PluginValidationError):
+        pi.load_registry(entry_points=False, plugins=[plugin])
+
+
+def test_a_name_taken_twice_is_an_error():
+    registry = pi.load_registry()
+    impostor = type("Impostor", (pi.ResistanceLaw,), {"name": "poncelet", "stress": None})
+    with pytest.raises(ValueError, match="registered twice"):
+        registry.add(impostor)
+
+
+def test_unknown_names_and_settings_list_the_choices():
+    registry = pi.load_registry()
+    with pytest.raises(pi.UnknownNameError, match="choose from: .*segment"):
+        registry.create("integrator", "rk99")
+    with pytest.raises(pi.ParameterError, match="settings: max_steps, step"):
+        registry.create("integrator", "segment", tolerance=1e-6)
+
+
+def _imports(package: Path) -> set[str]:
+    found = set()
+    for path in package.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                found.add(node.module)
+            elif isinstance(node, ast.Import):
+                found.update(alias.name for alias in node.names)
+    return found
+
+
+def test_plugins_use_only_the_public_api_and_the_core_never_imports_them():
+    plugin_imports = _imports(ROOT / "plugins")
+    assert not {m for m in plugin_imports if m.startswith("plateimpact.")}
+    assert not {m for m in _imports(ROOT / "framework") if m.startswith("plateimpact_plugins")}
