@@ -86,6 +86,10 @@ def test_turnaround_ring_is_continuous_and_symmetric(p):
     # Straight back out, the contact is symmetric about the path: no lift, ψ = 0.
     phi_out = force_inclination(np.array([p]), np.array([np.pi]), np.array([RS]))[0]
     assert phi_out == pytest.approx(np.pi, abs=1e-12)
+    # The report's eq 6 alone would put the force ψ = ½(3π/2 − α1) off the path here
+    # (54°–84° for these depths): the difference docs/model.md explains.
+    eq6 = min(0.5 * (alpha1 + np.pi - 0.5 * np.pi), np.pi)
+    assert np.pi - eq6 > np.radians(50.0)
     # ... and its presented area is the great circle minus the hole it came in by.
     re2 = 2 * RS * p - p**2
     assert area(p, np.pi)[0] == pytest.approx(np.pi * (RS**2 - re2), rel=1e-12)

@@ -104,6 +104,20 @@ class SceneBatch:
             validate=False,
         )
 
+    @classmethod
+    def concat(cls, batches: Iterable[SceneBatch]) -> SceneBatch:
+        """One batch holding the scenes of ``batches`` in order (same columns required)."""
+        batches = list(batches)
+        names = set(batches[0]._columns) if batches else set(BASE_COLUMNS)
+        if any(set(b._columns) != names for b in batches):
+            raise ValueError("batches to concatenate must have the same columns")
+        return cls(
+            {k: np.concatenate([b._columns[k] for b in batches]) for k in names}
+            if batches
+            else {k: np.zeros(0) for k in names},
+            validate=False,
+        )
+
     def __getattr__(self, name: str) -> np.ndarray:
         try:
             return self._columns[name]
