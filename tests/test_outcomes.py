@@ -117,7 +117,9 @@ def test_failed_plate_never_pushes_the_sphere_forward(sphere):
     bound = model.bind(batch)
     pen = rng.uniform(0.0, 4.0, n) * rs
     obl = rng.uniform(0.0, np.pi, n)
-    drag, _ = model.forces(pen, obl, rng.uniform(0.0, 2000.0, n), np.ones(n, bool), bound)
+    speed = rng.uniform(0.0, 2000.0, n)
+    state = model.new_failure_state(n)
+    drag, _ = model.forces(pen, obl, speed, np.ones(n, bool), state, bound)
     assert drag.min() >= 0.0
 
 

@@ -27,10 +27,18 @@ class FailureModel(ABC):
     Subclass, set ``name``, implement the three methods in numpy, and register the class
     from a ``plateimpact_register`` hook. Per-scene constants that do not change during
     the impact belong in :meth:`prepare`, which runs once per batch.
+
+    **Failure state.** A model whose failure evolves (the hinge's finger angle β) names
+    its variables in ``state_names``; the integrator then carries them per scene as an
+    array of shape ``(len(state_names), n)``, sets them with :meth:`initial_state` at
+    onset and advances them with :meth:`state_rates`. ``state`` arguments are that array,
+    restricted to the failed scenes; stateless models get shape ``(0, n)`` and ignore it.
     """
 
     name: ClassVar[str]
     version: ClassVar[str] = "1"
+    #: Names of the variables this model integrates after failure (default: none).
+    state_names: ClassVar[tuple[str, ...]] = ()
 
     def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
         """Per-scene columns to compute once per batch (default none)."""
@@ -46,6 +54,7 @@ class FailureModel(ABC):
         penetration: np.ndarray,
         obliquity: np.ndarray,
         speed: np.ndarray,
+        state: np.ndarray,
         batch: SceneBatch,
         law: ResistanceLaw,
     ) -> tuple[np.ndarray, np.ndarray]:
@@ -56,6 +65,31 @@ class FailureModel(ABC):
         self, penetration: np.ndarray, obliquity: np.ndarray, batch: SceneBatch
     ) -> np.ndarray:
         """A length [m] that crosses zero upward when perforation is complete."""
+
+    def initial_state(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        """Failure state at onset, shape ``(len(state_names), n)`` (default: empty)."""
+        return np.zeros((len(self.state_names), penetration.size))
+
+    def state_rates(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        obliquity_rate: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        """Time derivatives of the failure state [unit/s], same shape as ``state``.
+
+        ``obliquity_rate`` is dθ/dt [rad/s] from the net force, failure included.
+        """
+        return np.zeros_like(state)
 
     def settings(self) -> dict[str, object]:
         """The plug-in's settings, for archives (default: none)."""

@@ -36,7 +36,7 @@ class Integrator(ABC):
         self, model: ImpactModel, batch: SceneBatch, *, record_trajectory: bool = False
     ) -> BatchResult:
         """Integrate every scene of ``batch`` to its outcome."""
-        recorder = ResultRecorder(batch.size, record_trajectory)
+        recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
         if batch.size:
             self._integrate(model, model.bind(batch), recorder)
         return recorder.result()
@@ -57,9 +57,12 @@ class ResultRecorder:
     shrink its working arrays as scenes finish.
     """
 
-    def __init__(self, size: int, record_trajectory: bool) -> None:
+    def __init__(
+        self, size: int, record_trajectory: bool, failure_state_names: tuple[str, ...] = ()
+    ) -> None:
         self.size = size
         self.record_trajectory = record_trajectory
+        self.failure_state_names = failure_state_names
         self.columns: dict[str, np.ndarray] = {
             name: np.full(size, np.nan) for name in RESULT_FIELDS
         }
@@ -68,10 +71,27 @@ class ResultRecorder:
         self._samples: list[tuple[np.ndarray, ...]] = []
         self.stats: dict[str, float] = {"steps": 0, "force_evaluations": 0}
 
-    def sample(self, scene: np.ndarray, *state: np.ndarray) -> None:
-        """Record (time, penetration, lateral, obliquity, speed) for ``scene`` if asked."""
-        if self.record_trajectory:
-            self._samples.append((scene.copy(), *(np.array(s, dtype=float) for s in state)))
+    def sample(
+        self,
+        scene: np.ndarray,
+        time: np.ndarray,
+        penetration: np.ndarray,
+        lateral: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        failure_state: np.ndarray | None = None,
+    ) -> None:
+        """Record the state of ``scene`` s if trajectories were asked for.
+
+        ``failure_state`` has shape (len(failure_state_names), n); before failure its
+        values are meaningless and are recorded as NaN.
+        """
+        if not self.record_trajectory:
+            return
+        columns = [time, penetration, lateral, obliquity, speed]
+        if self.failure_state_names:
+            columns.extend(failure_state)
+        self._samples.append((scene.copy(), *(np.array(c, dtype=float) for c in columns)))
 
     def failed(
         self, scene: np.ndarray, time: np.ndarray, penetration: np.ndarray, lateral: np.ndarray
@@ -103,12 +123,13 @@ class ResultRecorder:
         """The batch's results; trajectories as contiguous ragged arrays."""
         trajectory = counts = None
         if self.record_trajectory:
+            names = [*TRAJECTORY_FIELDS, *(f"failure_{n}" for n in self.failure_state_names)]
             if self._samples:
                 stacked = [np.concatenate(part) for part in zip(*self._samples, strict=True)]
             else:
-                stacked = [np.zeros(0, dtype=int)] + [np.zeros(0)] * len(TRAJECTORY_FIELDS)
+                stacked = [np.zeros(0, dtype=int)] + [np.zeros(0)] * len(names)
             scene, *values = stacked
             order = np.argsort(scene, kind="stable")  # samples were appended in time order
-            trajectory = {k: x[order] for k, x in zip(TRAJECTORY_FIELDS, values, strict=True)}
+            trajectory = {k: x[order] for k, x in zip(names, values, strict=True)}
             counts = np.bincount(scene, minlength=self.size)
         return BatchResult(dict(self.columns), trajectory, counts, dict(self.stats))

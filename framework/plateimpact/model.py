@@ -50,15 +50,23 @@ class ImpactModel:
             **extra,
         )
 
+    def new_failure_state(self, size: int) -> np.ndarray:
+        """Failure-state array for ``size`` scenes, shape (len(state_names), size).
+
+        NaN until :meth:`start_failure` sets it: before failure it means nothing.
+        """
+        return np.full((len(self.failure.state_names), size), np.nan)
+
     def forces(
         self,
         penetration: np.ndarray,
         obliquity: np.ndarray,
         speed: np.ndarray,
         failed: np.ndarray,
+        failure_state: np.ndarray,
         batch: SceneBatch,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Net drag and lift [N] on every scene (eqs 1, 15, 22–24).
+        """Net drag and lift [N] on every scene (eqs 1, 15, 21–24).
 
         The failure model is consulted only for the scenes whose plate has failed.
         """
@@ -69,12 +77,53 @@ class ImpactModel:
                 penetration[index],
                 obliquity[index],
                 speed[index],
+                failure_state[:, index],
                 batch.take(index),
                 self.resistance,
             )
             drag[index] += extra_drag
             lift[index] += extra_lift
         return drag, lift
+
+    def start_failure(
+        self,
+        onset: np.ndarray,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        failure_state: np.ndarray,
+        batch: SceneBatch,
+    ) -> None:
+        """Set the failure state of the scenes in the boolean mask ``onset`` (in place)."""
+        if failure_state.shape[0] and onset.any():
+            index = np.flatnonzero(onset)
+            failure_state[:, index] = self.failure.initial_state(
+                penetration[index], obliquity[index], speed[index], batch.take(index)
+            )
+
+    def failure_state_rates(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        obliquity_rate: np.ndarray,
+        failed: np.ndarray,
+        failure_state: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        """d(failure state)/dt; zero for intact scenes and stateless models."""
+        rates = np.zeros_like(failure_state)
+        if failure_state.shape[0] and failed.any():
+            index = np.flatnonzero(failed)
+            rates[:, index] = self.failure.state_rates(
+                penetration[index],
+                obliquity[index],
+                speed[index],
+                obliquity_rate[index],
+                failure_state[:, index],
+                batch.take(index),
+            )
+        return rates
 
     def perforation_margin(
         self,

@@ -37,7 +37,8 @@ class Trajectory:
     """The sampled path of the sphere's centre, one entry per integrator step.
 
     Attributes: time [s]; penetration P [m] (depth of the sphere's deepest point);
-    lateral Y [m]; obliquity θ [rad]; speed V [m/s].
+    lateral Y [m]; obliquity θ [rad]; speed V [m/s]; failure_state, the failure model's
+    state variables by name (e.g. ``finger_angle`` [rad]), meaningful from failure on.
     """
 
     time: np.ndarray
@@ -45,6 +46,7 @@ class Trajectory:
     lateral: np.ndarray
     obliquity: np.ndarray
     speed: np.ndarray
+    failure_state: dict[str, np.ndarray] = attrs.field(factory=dict)
 
 
 @attrs.frozen
@@ -157,7 +159,14 @@ class BatchResult:
         if self.trajectory is None:
             return None
         lo, hi = self.trajectory_offsets[i], self.trajectory_offsets[i + 1]
-        return Trajectory(**{k: self.trajectory[k][lo:hi] for k in TRAJECTORY_FIELDS})
+        state = {
+            k.removeprefix("failure_"): v[lo:hi]
+            for k, v in self.trajectory.items()
+            if k.startswith("failure_")
+        }
+        return Trajectory(
+            **{k: self.trajectory[k][lo:hi] for k in TRAJECTORY_FIELDS}, failure_state=state
+        )
 
     def result(self, i: int) -> Result:
         """Scene ``i`` as a :class:`Result`."""

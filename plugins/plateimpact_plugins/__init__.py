@@ -8,16 +8,30 @@ from __future__ import annotations
 
 from plateimpact import PluginRegistry, hookimpl
 
+from .hinge import Hinge
 from .intact import Intact
 from .plugging import Plugging
 from .poncelet import Poncelet
 from .segment import Segment
+from .separation import PlaneSeparation
+from .variable_pstar import SAE1010_TABLE, PstarTable, VariablePstar
 
-__all__ = ["Intact", "Plugging", "Poncelet", "Segment", "plateimpact_register"]
+__all__ = [
+    "SAE1010_TABLE",
+    "Hinge",
+    "Intact",
+    "PlaneSeparation",
+    "Plugging",
+    "Poncelet",
+    "PstarTable",
+    "Segment",
+    "VariablePstar",
+    "plateimpact_register",
+]
 
 
 @hookimpl
 def plateimpact_register(registry: PluginRegistry) -> None:
     """Register the built-in resistance law, failure models and integrators."""
-    for cls in (Poncelet, Plugging, Intact, Segment):
+    for cls in (Poncelet, Plugging, Hinge, VariablePstar, Intact, Segment):
         registry.add(cls)

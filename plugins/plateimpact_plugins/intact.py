@@ -29,6 +29,7 @@ class Intact(FailureModel):
         penetration: np.ndarray,
         obliquity: np.ndarray,
         speed: np.ndarray,
+        state: np.ndarray,
         batch: SceneBatch,
         law: ResistanceLaw,
     ) -> tuple[np.ndarray, np.ndarray]:

@@ -102,12 +102,16 @@ class Segment(Integrator):
         spd = batch.impact_speed.copy()
         time = np.zeros(batch.size)
         failed = np.zeros(batch.size, dtype=bool)
+        failure_state = model.new_failure_state(batch.size)
         max_pen = np.zeros(batch.size)
         nominal_dt = self.step * batch.radius / batch.impact_speed
-        recorder.sample(scene, time, pen, lat, obl, spd)
+        recorder.sample(scene, time, pen, lat, obl, spd, failure_state)
 
         for _ in range(self.max_steps):
-            drag, lift = model.forces(pen, obl, spd, failed, batch)
+            drag, lift = model.forces(pen, obl, spd, failed, failure_state, batch)
+            state_rates = model.failure_state_rates(
+                pen, obl, spd, lift / (batch.mass * spd), failed, failure_state, batch
+            )
             recorder.stats["force_evaluations"] += scene.size
             recorder.stats["steps"] += 1
             # Rest: the segment that reaches the rest speed ends on it exactly.
@@ -127,11 +131,13 @@ class Segment(Integrator):
             at_rest = rest_dt <= dt
             pen, lat, obl, spd = new
             time = time + dt
+            failure_state = failure_state + state_rates * dt
             np.maximum(max_pen, pen, out=max_pen)
             if onset.any():
                 failed = failed | onset
+                model.start_failure(onset, pen, obl, spd, failure_state, batch)
                 recorder.failed(scene[onset], time[onset], pen[onset], lat[onset])
-            recorder.sample(scene, time, pen, lat, obl, spd)
+            recorder.sample(scene, time, pen, lat, obl, spd, failure_state)
 
             status = model.classify(pen, obl, failed, at_rest, batch)
             done = status > 0
@@ -146,6 +152,7 @@ class Segment(Integrator):
                 scene, batch = scene[keep], batch.take(keep)
                 pen, lat, obl, spd = pen[keep], lat[keep], obl[keep], spd[keep]
                 time, failed, max_pen = time[keep], failed[keep], max_pen[keep]
+                failure_state = failure_state[:, keep]
                 nominal_dt = nominal_dt[keep]
         raise IntegrationError(
             f"segment: {scene.size} scene(s) unfinished after max_steps={self.max_steps} "

@@ -1,0 +1,128 @@
+"""Hinge ("finger") failure of oblique impacts on steel (report eqs 7, 16–21)."""
+
+from __future__ import annotations
+
+from typing import final
+
+import attrs
+import numpy as np
+
+from plateimpact import ParameterError, ResistanceLaw, SceneBatch
+
+from .separation import PlaneSeparation
+
+HALF_PI = 0.5 * np.pi
+
+
+def _non_negative(instance: object, attribute: attrs.Attribute, value: float) -> None:
+    if not (isinstance(value, int | float) and np.isfinite(value) and value >= 0.0):
+        raise ParameterError(attribute.name, f"{attribute.name} must be >= 0, got {value!r}")
+
+
+def _hinge_obliquity(instance: object, attribute: attrs.Attribute, value: float | None) -> None:
+    if value is not None and not (isinstance(value, int | float) and 0.0 < value < HALF_PI):
+        raise ParameterError(
+            attribute.name, f"{attribute.name} must be in (0, 90) deg, got {value!r} rad"
+        )
+
+
+@final
+@attrs.frozen
+class Hinge(PlaneSeparation):
+    """Plugging relief plus the resistance of a finger of plate hinged ahead of the sphere.
+
+    At onset the plate separates as in plugging (eqs 8–15), but on oblique impacts on
+    steel the separated material stays attached at a hinge and keeps pushing on the
+    sphere over a cap of angular width β (the finger angle, Figure 9 of the report):
+
+        F″ = As σ(V, ψ″),   As = π [Rs sin(β/2)]²          (eqs 16–17)
+
+    with σ the resistance law (eq 1 for Poncelet). The net force is F* − F′ + F″ (eq 21),
+    each part's drag and lift with its own angle. The finger angle:
+
+    * starts at 2α* − max(θ − θ1, 0) at onset (the report: α* + 90° − θ if that is less
+      than 2α*, else 2α*), and is held at 2α* while θ <= θ1;
+    * then shrinks as the sphere rolls along the finger: dβ = −dθ − dS/Rs (eqs 7, 18),
+      never growing back (a finger that has peeled off does not re-attach);
+    * stops acting when it reaches 0 (As = 0 from then on).
+
+    F″ acts at ψ″ = 90° + θ − θ1 − β/2 from the path while θ < θ1 and 90° − β/2 after
+    (eqs 19–20), on the same side as F*: its drag resists the motion and its lift turns
+    the sphere outward. θ1 = 90° − α* (model-notes §5; docs/hinge.md gives the reasons).
+
+    Parameters
+    ----------
+    finger_area_scale : float
+        Multiplies As, >= 0 (default 1). 0 removes the finger: the model is then plugging,
+        bit for bit.
+    hinge_obliquity : float or None
+        θ1 [rad], in (0, π/2); None for 90° − α* of each plate.
+    """
+
+    name = "hinge"
+    state_names = ("finger_angle",)
+
+    finger_area_scale: float = attrs.field(default=1.0, validator=_non_negative)
+    hinge_obliquity: float | None = attrs.field(default=None, validator=_hinge_obliquity)
+
+    def settings(self) -> dict[str, object]:
+        return {
+            "finger_area_scale": self.finger_area_scale,
+            "hinge_obliquity": self.hinge_obliquity,
+        }
+
+    def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
+        return batch.critical_penetration
+
+    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
+        theta1 = (
+            HALF_PI - batch.failure_angle
+            if self.hinge_obliquity is None
+            else np.full(batch.size, self.hinge_obliquity)
+        )
+        return {**super().prepare(batch), "hinge_obliquity": theta1}
+
+    def initial_state(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        full = 2.0 * batch.failure_angle
+        return (full - np.maximum(obliquity - batch.hinge_obliquity, 0.0))[np.newaxis]
+
+    def state_rates(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        obliquity_rate: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        finger_angle = state[0]
+        held = (obliquity <= batch.hinge_obliquity) & (finger_angle >= 2.0 * batch.failure_angle)
+        peeling = np.maximum(obliquity_rate + speed / batch.radius, 0.0)  # eq 18 per unit time
+        return np.where(held | (finger_angle <= 0.0), 0.0, -peeling)[np.newaxis]
+
+    def force_change(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+        law: ResistanceLaw,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        drag, lift = self.relief(penetration, obliquity, speed, batch, law)
+        half_angle = 0.5 * np.maximum(state[0], 0.0)
+        finger_area = self.finger_area_scale * np.pi * (batch.radius * np.sin(half_angle)) ** 2
+        theta1 = batch.hinge_obliquity
+        incidence = np.where(
+            obliquity < theta1,
+            HALF_PI + obliquity - theta1 - half_angle,  # eq 19
+            HALF_PI - half_angle,  # eq 20
+        )
+        finger_force = finger_area * law.stress(speed, incidence, batch)  # eqs 16–17
+        return drag + finger_force * np.cos(incidence), lift + finger_force * np.sin(incidence)

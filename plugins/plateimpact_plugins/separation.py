@@ -1,0 +1,67 @@
+"""What plugging, hinge and variable-P* failure share: separation along a fixed plane."""
+
+from __future__ import annotations
+
+from abc import abstractmethod
+
+import numpy as np
+
+from plateimpact import FailureModel, ResistanceLaw, SceneBatch, contact_force
+
+
+class PlaneSeparation(FailureModel):
+    """Abstract: at onset the plate separates along the ring at α* on the sphere.
+
+    The ring's depth at onset, h = Rs cos α* + P* − Rs (eq 8 with P = P*, the onset
+    penetration), defines a plane fixed in the plate (α* is measured "with respect to the
+    plate orientation"). Material deeper than h no longer resists: the relieved force F′
+    is the resistance law on the part of the contact surface below that plane (eqs 9–14,
+    i.e. eqs 2–6 with P − h for P), subtracted from the intact force F* as a vector
+    (eq 15; drag and lift each with its own inclination). When h < 0 the ring is still
+    above the front surface at onset and the whole contact region separates: h = 0.
+
+    Perforation is complete when the front layer 0 < z < h no longer touches the forward
+    hemisphere: P − h >= Rs (1 + sin θ) while θ < 90°.
+
+    Subclasses say when failure starts (:meth:`onset_penetration`) and may add to the
+    force (:meth:`force_change` of the hinge adds the finger).
+    """
+
+    @abstractmethod
+    def onset_penetration(self, batch: SceneBatch) -> np.ndarray: ...
+
+    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
+        onset = self.onset_penetration(batch)
+        ring_depth = batch.radius * np.cos(batch.failure_angle) + onset - batch.radius  # eq 8
+        return {"failure_plane_depth": np.maximum(ring_depth, 0.0)}
+
+    def relief(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        batch: SceneBatch,
+        law: ResistanceLaw,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""
+        below_plane = penetration - batch.failure_plane_depth
+        relieved_drag, relieved_lift = contact_force(law, below_plane, obliquity, speed, batch)
+        return -relieved_drag, -relieved_lift
+
+    def force_change(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+        law: ResistanceLaw,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        return self.relief(penetration, obliquity, speed, batch, law)
+
+    def perforation_margin(
+        self, penetration: np.ndarray, obliquity: np.ndarray, batch: SceneBatch
+    ) -> np.ndarray:
+        # Depth of the forward hemisphere's shallowest point below the failure plane.
+        reach = batch.radius * (1.0 + np.sin(np.minimum(obliquity, 0.5 * np.pi)))
+        return penetration - batch.failure_plane_depth - reach
