@@ -173,3 +173,95 @@ def test_installed_command_exits_2_without_traceback():
     assert done.stderr == (
         "plateimpact: error: --obliquity: impact_obliquity must be in [0, 90) deg, got 95 deg\n"
     )
+
+
+@pytest.mark.parametrize("failure", ["plugging", "hinge", "variable-pstar", "intact"])
+def test_every_failure_model_is_selectable_by_name(failure, capsys):
+    assert (
+        main(
+            [
+                "run",
+                "--preset",
+                "SAE1010/1.47",
+                "--speed",
+                "500",
+                "--obliquity",
+                "45",
+                "--failure",
+                failure,
+                "--step",
+                "4e-3",
+                "--json",
+            ]
+        )
+        == 0
+    )
+    assert json.loads(capsys.readouterr().out)["model"]["failure"] == failure
+
+
+def test_crater_writes_csv_and_png(tmp_path, capsys):
+    table, picture = tmp_path / "crater.csv", tmp_path / "crater.png"
+    assert (
+        main(
+            [
+                "crater",
+                "--preset",
+                "6061-T6/9.53",
+                "--speed",
+                "263",
+                "--obliquity",
+                "60",
+                "--csv",
+                str(table),
+                "--png",
+                str(picture),
+            ]
+        )
+        == 0
+    )
+    assert "ricochet; crater" in capsys.readouterr().out
+    rows = list(csv.reader(table.open()))
+    assert rows[0] == ["lateral_mm", "depth_mm"] and rows[1] == ["0.0", "0.0"]
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(tmp_path.glob(".plateimpact-*"))  # no temporary file left behind
+
+
+def test_pstar_table_from_the_command_line(tmp_path, capsys):
+    good = tmp_path / "table.csv"
+    good.write_text(
+        "obliquity_deg,ricochet_pstar_mm,perforation_pstar_mm,"
+        "transition_start_m_s,transition_end_m_s\n0,3.0,3.0,0,0\n"
+    )
+    base = [
+        "run",
+        "--preset",
+        "SAE1010/1.47",
+        "--speed",
+        "500",
+        "--obliquity",
+        "45",
+        "--step",
+        "4e-3",
+        "--json",
+    ]
+    assert main([*base, "--failure", "variable-pstar", "--pstar-table", str(good)]) == 0
+    assert main([*base, "--pstar", "3.0"]) == 0
+    variable, constant = (json.loads(x) for x in capsys.readouterr().out.splitlines())
+    assert variable["exit_speed_m_s"] == constant["exit_speed_m_s"]
+
+    bad = tmp_path / "bad.csv"
+    bad.write_text(
+        "obliquity_deg,ricochet_pstar_mm,perforation_pstar_mm,"
+        "transition_start_m_s,transition_end_m_s\n45,3,3,0,0\n30,3,3,0,0\n"
+    )
+    for args, expected in [
+        (["--failure", "variable-pstar", "--pstar-table", str(bad)], "strictly increasing"),
+        (
+            ["--failure", "variable-pstar", "--pstar-table", str(tmp_path / "none.csv")],
+            "cannot read",
+        ),
+        (["--pstar-table", str(good)], "has no setting 'table'"),
+    ]:
+        assert main([*base, *args]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and expected in err

@@ -69,6 +69,13 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--failure", default=DEFAULT_FAILURE, help="failure model")
     group.add_argument("--integrator", default=DEFAULT_INTEGRATOR, help="integrator")
     group.add_argument(
+        "--pstar-table",
+        metavar="FILE",
+        help="CSV of P* by obliquity and speed, for --failure variable-pstar "
+        "(columns obliquity_deg,ricochet_pstar_mm,perforation_pstar_mm,"
+        "transition_start_m_s,transition_end_m_s)",
+    )
+    group.add_argument(
         "--step",
         type=float,
         help="integrator step; for 'segment', the segment duration as a fraction of "
@@ -103,6 +110,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--obliquity", type=float, required=True, help="impact obliquity [deg]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--trajectory", metavar="FILE", help="write the trajectory as CSV")
+    _add_body_options(p)
+    _add_model_options(p)
+
+    p = sub.add_parser("crater", help="the crater section of one scene (eqs 31-39)")
+    p.add_argument("--speed", type=float, required=True, help="impact speed [m/s]")
+    p.add_argument("--obliquity", type=float, required=True, help="impact obliquity [deg]")
+    p.add_argument("--csv", metavar="FILE", help="write lateral_mm,depth_mm here")
+    p.add_argument("--png", metavar="FILE", help="draw the crater here")
     _add_body_options(p)
     _add_model_options(p)
 
@@ -157,8 +172,13 @@ def _bodies(args: argparse.Namespace) -> tuple[Sphere, Plate, str]:
 
 def _simulation(args: argparse.Namespace) -> Simulation:
     settings = {} if args.step is None else {"step": args.step}
+    failure_settings = {} if args.pstar_table is None else {"table": args.pstar_table}
     return Simulation.from_names(
-        args.resistance, args.failure, args.integrator, integrator_settings=settings
+        args.resistance,
+        args.failure,
+        args.integrator,
+        integrator_settings=settings,
+        failure_settings=failure_settings,
     )
 
 
@@ -288,6 +308,43 @@ def _cmd_run(args: argparse.Namespace) -> None:
         print("  plate failed     no")
 
 
+def _cmd_crater(args: argparse.Namespace) -> None:
+    from .crater import crater_section
+
+    _check_directory(args.csv, "--csv")
+    _check_directory(args.png, "--png")
+    sphere, plate, label = _bodies(args)
+    scene = Scene(sphere, plate, args.speed, args.obliquity * deg)
+    result = _simulation(args).run(scene, record_trajectory=True)
+    section = crater_section(result.trajectory, sphere.radius)
+    print(
+        f"{label}: {args.speed:g} m/s at {args.obliquity:g} deg -> {result.outcome.label}; "
+        f"crater {section.length / mm:.4g} mm long, {section.max_depth / mm:.4g} mm deep"
+    )
+    if args.csv is not None:
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        writer.writerow(["lateral_mm", "depth_mm"])
+        for y, x in zip(section.lateral / mm, section.depth / mm, strict=True):
+            writer.writerow([repr(float(y)), repr(float(x))])
+        _write_atomically(args.csv, buffer.getvalue(), "--csv")
+    if args.png is not None:
+        from . import plotting
+
+        fig, ax = plotting.plt.subplots(figsize=(8, 4))
+        plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=sphere.radius)
+        ax.set_title(f"{label}, {args.speed:g} m/s at {args.obliquity:g}°: {result.outcome.label}")
+        directory = os.path.dirname(os.path.abspath(args.png))
+        fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".png")
+        os.close(fd)
+        try:
+            plotting.save(fig, tmp)
+            os.replace(tmp, args.png)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+
+
 def _cmd_sweep(args: argparse.Namespace) -> None:
     _check_directory(args.csv, "--csv")
     sphere, plate, label = _bodies(args)
@@ -329,6 +386,7 @@ COMMANDS = {
     "presets": _cmd_presets,
     "plugins": _cmd_plugins,
     "run": _cmd_run,
+    "crater": _cmd_crater,
     "sweep": _cmd_sweep,
 }
 
