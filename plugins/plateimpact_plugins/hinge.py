@@ -106,6 +106,23 @@ class Hinge(PlaneSeparation):
         peeling = np.maximum(obliquity_rate + speed / batch.radius, 0.0)  # eq 18 per unit time
         return np.where(held | (finger_angle <= 0.0), 0.0, -peeling)[np.newaxis]
 
+    def finger(
+        self, obliquity: np.ndarray, finger_angle: np.ndarray, batch: SceneBatch
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The finger's presented area As [m²] (eq 17) and the angle ψ″ [rad] of its force
+        from the path (eqs 19–20). The finger touches the sphere over the cap of angular
+        width β centred on that force line, i.e. from θ − ψ″ − β/2 to θ − ψ″ + β/2 from
+        the plate normal."""
+        half_angle = 0.5 * np.maximum(finger_angle, 0.0)
+        area = self.finger_area_scale * np.pi * (batch.radius * np.sin(half_angle)) ** 2
+        theta1 = batch.hinge_obliquity
+        incidence = np.where(
+            obliquity < theta1,
+            HALF_PI + obliquity - theta1 - half_angle,  # eq 19
+            HALF_PI - half_angle,  # eq 20
+        )
+        return area, incidence
+
     def force_change(
         self,
         penetration: np.ndarray,
@@ -116,13 +133,6 @@ class Hinge(PlaneSeparation):
         law: ResistanceLaw,
     ) -> tuple[np.ndarray, np.ndarray]:
         drag, lift = self.relief(penetration, obliquity, speed, batch, law)
-        half_angle = 0.5 * np.maximum(state[0], 0.0)
-        finger_area = self.finger_area_scale * np.pi * (batch.radius * np.sin(half_angle)) ** 2
-        theta1 = batch.hinge_obliquity
-        incidence = np.where(
-            obliquity < theta1,
-            HALF_PI + obliquity - theta1 - half_angle,  # eq 19
-            HALF_PI - half_angle,  # eq 20
-        )
-        finger_force = finger_area * law.stress(speed, incidence, batch)  # eqs 16–17
+        area, incidence = self.finger(obliquity, state[0], batch)
+        finger_force = area * law.stress(speed, incidence, batch)  # eq 16
         return drag + finger_force * np.cos(incidence), lift + finger_force * np.sin(incidence)
