@@ -22,12 +22,17 @@ def sweep(
     speeds: np.ndarray,
     obliquity_deg: float,
     *,
+    integrator: str = "dopri5",
     step: float = 2e-3,
     failure: str = "plugging",
     record_trajectory: bool = False,
 ) -> pi.BatchResult:
-    """Results of one plate preset at one obliquity over ``speeds`` [m/s]."""
-    simulation = pi.Simulation.from_names(failure=failure, integrator_settings={"step": step})
+    """Results of one plate preset at one obliquity over ``speeds`` [m/s]; ``step`` is
+    used by the segment integrator only."""
+    settings = {"step": step} if integrator == "segment" else {}
+    simulation = pi.Simulation.from_names(
+        failure=failure, integrator=integrator, integrator_settings=settings
+    )
     batch = pi.SceneBatch.grid(
         presets.DEFAULT_SPHERE,
         presets.plate(plate),

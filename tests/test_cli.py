@@ -32,7 +32,7 @@ def test_run_json_has_the_documented_fields(capsys):
     for key in ("exit_speed_m_s", "exit_obliquity_deg", "contact_time_s", "max_penetration_mm"):
         assert isinstance(out[key], float)
     assert isinstance(out["plate_failed"], bool)
-    assert out["model"]["integrator"] == "segment"
+    assert out["model"]["integrator"] == "dopri5"
 
 
 def test_run_overrides_match_the_python_api(capsys):
@@ -81,6 +81,8 @@ def test_sweep_writes_one_row_per_scene(tmp_path, capsys):
         "100:1000:4",
         "--obliquities",
         "0,60",
+        "--integrator",
+        "segment",
         "--step",
         "4e-3",
     ]
@@ -113,7 +115,9 @@ def test_sweep_writes_one_row_per_scene(tmp_path, capsys):
         (["--a", "0"], "--a"),
         (["--integrator", "rk99"], "unknown integrator"),
         (["--failure", "shatter"], "unknown failure"),
-        (["--step", "1"], "step"),
+        (["--integrator", "segment", "--step", "1"], "--step"),
+        (["--rtol", "1"], "--rtol"),
+        (["--step", "1e-3"], "has no setting 'step'"),
     ],
 )
 def test_run_bad_input_is_one_line_and_exit_2(args, named, capsys):
@@ -189,8 +193,6 @@ def test_every_failure_model_is_selectable_by_name(failure, capsys):
                 "45",
                 "--failure",
                 failure,
-                "--step",
-                "4e-3",
                 "--json",
             ]
         )
@@ -240,8 +242,6 @@ def test_pstar_table_from_the_command_line(tmp_path, capsys):
         "500",
         "--obliquity",
         "45",
-        "--step",
-        "4e-3",
         "--json",
     ]
     assert main([*base, "--failure", "variable-pstar", "--pstar-table", str(good)]) == 0

@@ -11,7 +11,7 @@ from plateimpact.crater import crater_section
 from plateimpact.units import deg
 
 RS = presets.DEFAULT_SPHERE.radius
-SIMULATION = pi.Simulation.from_names(integrator_settings={"step": 1e-3})
+SIMULATION = pi.Simulation.from_names(integrator="segment", integrator_settings={"step": 1e-3})
 
 
 def crater(plate, speed, obliquity_deg):

@@ -42,7 +42,7 @@ def test_thin_plate_ricochets_after_failure_just_below_embedment():
     # Report, thin-plate ricochet: failure during ricochet gives a narrow band of
     # ricochets at lower exit speed and higher exit obliquity just below the embedment
     # range -- a spike in exit obliquity and a precipitous drop in exit speed.
-    speeds = np.arange(150.0, 262.0, 4.0)
+    speeds = np.arange(150.0, 262.0, 1.0)  # the embedment range is 206.25–208.75 m/s
     result = sweep("2024-T3/1.27", speeds, 45.0)
     ricochet = result.outcome == pi.Outcome.RICOCHET
     band = ricochet & result.plate_failed
@@ -71,8 +71,7 @@ def test_invariants_on_random_scenes():
         )
         for _ in range(40)
     ]
-    simulation = pi.Simulation.from_names(integrator_settings={"step": 4e-3})
-    result = simulation.run_batch(scenes, record_trajectory=True)
+    result = pi.Simulation.from_names().run_batch(scenes, record_trajectory=True)
     speed = np.array([s.impact_speed for s in scenes])
     pstar = np.array([s.plate.critical_penetration for s in scenes])
     outcome, exit_obliquity = result.outcome, result.exit_obliquity
@@ -89,9 +88,9 @@ def test_invariants_on_random_scenes():
     np.testing.assert_allclose(
         result.failure_penetration[result.plate_failed], pstar[result.plate_failed], rtol=1e-4
     )
-    # A resisting plate never speeds the sphere up.
+    # A resisting plate never speeds the sphere up (dense output: to rounding).
     for i in range(len(scenes)):
-        assert np.all(np.diff(result.trajectory_of(i).speed) <= 0.0), i
+        assert np.all(np.diff(result.trajectory_of(i).speed) <= 1e-9 * speed[i]), i
 
 
 def test_failed_plate_never_pushes_the_sphere_forward(sphere):
@@ -123,7 +122,8 @@ def test_failed_plate_never_pushes_the_sphere_forward(sphere):
     assert drag.min() >= 0.0
 
 
-def test_scene_result_does_not_depend_on_its_batch(sphere):
+@pytest.mark.parametrize("integrator", ["segment", "dopri5"])
+def test_scene_result_does_not_depend_on_its_batch(sphere, integrator):
     target = pi.Scene(sphere, presets.plate("2024-T3/3.18"), 640.0, np.radians(60.0))
     others = [
         pi.Scene(sphere, presets.plate(name), speed, np.radians(ob))
@@ -133,7 +133,7 @@ def test_scene_result_does_not_depend_on_its_batch(sphere):
             ("2024-T3/1.27", 200.0, 45.0),
         ]
     ]
-    simulation = pi.Simulation.from_names(integrator_settings={"step": 2e-3})
+    simulation = pi.Simulation.from_names(integrator=integrator)
     alone = simulation.run_batch([target])
     mixed = simulation.run_batch([others[0], target, *others[1:]])
     for name, column in alone.columns.items():
@@ -149,7 +149,7 @@ class TestRestRule:
     def run(self, sphere, step, fraction=1e-2, record=False):
         plate, speed, obliquity = self.SCENE_ARGS
         simulation = pi.Simulation.from_names(
-            integrator_settings={"step": step}, rest_speed_fraction=fraction
+            integrator="segment", integrator_settings={"step": step}, rest_speed_fraction=fraction
         )
         scene = pi.Scene(sphere, presets.plate(plate), speed, np.radians(obliquity))
         return simulation.run(scene, record_trajectory=record)

@@ -53,9 +53,7 @@ def test_bad_configuration_names_parameter_and_range(build, parameter, allowed):
 
 def test_a_never_failing_plate_is_allowed():
     plate = attrs.evolve(PLATE, critical_penetration=math.inf)
-    result = pi.Simulation.from_names(integrator_settings={"step": 4e-3}).run(
-        pi.Scene(SPHERE, plate, 1500.0, 0.0)
-    )
+    result = pi.Simulation.from_names().run(pi.Scene(SPHERE, plate, 1500.0, 0.0))
     assert not result.plate_failed and result.outcome is pi.Outcome.EMBEDMENT
 
 
@@ -74,4 +72,4 @@ def test_unknown_preset_lists_the_presets():
 def test_segment_step_must_be_in_range():
     for step in (0.0, -1e-3, 0.5):
         with pytest.raises(pi.ParameterError, match=r"step must be in \(0, 0.1\]"):
-            pi.Simulation.from_names(integrator_settings={"step": step})
+            pi.Simulation.from_names(integrator="segment", integrator_settings={"step": step})

@@ -21,7 +21,20 @@ from .failure import FailureModel
 from .geometry import contact_geometry, contact_lost_margin, force_inclination
 from .hookspecs import hookimpl
 from .integrator import Integrator, ResultRecorder
-from .model import ImpactModel
+from .model import (
+    AT_REST,
+    CONTACT_LOST,
+    EVENT_NAMES,
+    KINEMATIC_STATE,
+    LATERAL,
+    OBLIQUITY,
+    ONSET,
+    PENETRATION,
+    PERFORATED,
+    SPEED,
+    TURNED_BACK,
+    ImpactModel,
+)
 from .registry import PluginRegistry, default_registry, load_registry
 from .resistance import ResistanceLaw, contact_force
 from .results import BatchResult, Outcome, Result, Trajectory
@@ -34,6 +47,17 @@ except PackageNotFoundError:  # running from a source tree
     __version__ = "0+unknown"
 
 __all__ = [
+    "AT_REST",
+    "CONTACT_LOST",
+    "EVENT_NAMES",
+    "KINEMATIC_STATE",
+    "LATERAL",
+    "OBLIQUITY",
+    "ONSET",
+    "PENETRATION",
+    "PERFORATED",
+    "SPEED",
+    "TURNED_BACK",
     "BatchResult",
     "FailureModel",
     "ImpactModel",

@@ -39,6 +39,7 @@ FLAG_OF = {
     "radius": "--radius",
     "mass": "--mass",
     "step": "--step",
+    "rtol": "--rtol",
 }
 
 SWEEP_COLUMNS = (
@@ -78,8 +79,14 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--step",
         type=float,
-        help="integrator step; for 'segment', the segment duration as a fraction of "
-        "Rs/Vs (default 1e-3, finest documented 1e-4)",
+        help="for --integrator segment: the segment duration as a fraction of Rs/Vs "
+        "(default 1e-3, finest documented 1e-4)",
+    )
+    group.add_argument(
+        "--rtol",
+        type=float,
+        help="for adaptive integrators (dopri5, solve_ivp): relative tolerance "
+        "(dopri5 default 1e-9)",
     )
 
 
@@ -172,6 +179,8 @@ def _bodies(args: argparse.Namespace) -> tuple[Sphere, Plate, str]:
 
 def _simulation(args: argparse.Namespace) -> Simulation:
     settings = {} if args.step is None else {"step": args.step}
+    if args.rtol is not None:
+        settings["rtol"] = args.rtol
     failure_settings = {} if args.pstar_table is None else {"table": args.pstar_table}
     return Simulation.from_names(
         args.resistance,

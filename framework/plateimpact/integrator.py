@@ -80,17 +80,19 @@ class ResultRecorder:
         obliquity: np.ndarray,
         speed: np.ndarray,
         failure_state: np.ndarray | None = None,
+        failed: np.ndarray | None = None,
     ) -> None:
         """Record the state of ``scene`` s if trajectories were asked for.
 
-        ``failure_state`` has shape (len(failure_state_names), n); before failure its
-        values are meaningless and are recorded as NaN.
+        ``failure_state`` has shape (len(failure_state_names), n); where ``failed`` is
+        False it means nothing and is recorded as NaN.
         """
         if not self.record_trajectory:
             return
         columns = [time, penetration, lateral, obliquity, speed]
         if self.failure_state_names:
-            columns.extend(failure_state)
+            mask = np.ones(np.shape(time), bool) if failed is None else failed
+            columns.extend(np.where(mask, failure_state, np.nan))
         self._samples.append((scene.copy(), *(np.array(c, dtype=float) for c in columns)))
 
     def failed(
@@ -129,7 +131,7 @@ class ResultRecorder:
             else:
                 stacked = [np.zeros(0, dtype=int)] + [np.zeros(0)] * len(names)
             scene, *values = stacked
-            order = np.argsort(scene, kind="stable")  # samples were appended in time order
+            order = np.lexsort((values[0], scene))  # by scene, then by time
             trajectory = {k: x[order] for k, x in zip(names, values, strict=True)}
             counts = np.bincount(scene, minlength=self.size)
         return BatchResult(dict(self.columns), trajectory, counts, dict(self.stats))

@@ -16,6 +16,15 @@ from .results import Outcome
 
 REST_SPEED_FRACTION = v.Range(0.0, 1.0, True, True)
 
+#: Rows of the state vector y used by ODE integrators: P [m], Y [m], θ [rad], V [m/s],
+#: then the failure model's state variables.
+PENETRATION, LATERAL, OBLIQUITY, SPEED = range(4)
+KINEMATIC_STATE = 4
+
+#: Rows of :meth:`ImpactModel.event_margins`. Each margin crosses zero upward at its event.
+ONSET, CONTACT_LOST, PERFORATED, AT_REST, TURNED_BACK = range(5)
+EVENT_NAMES = ("failure onset", "contact lost", "perforated", "at rest", "turned back")
+
 
 @attrs.frozen
 class ImpactModel:
@@ -71,6 +80,11 @@ class ImpactModel:
         The failure model is consulted only for the scenes whose plate has failed.
         """
         drag, lift = contact_force(self.resistance, penetration, obliquity, speed, batch)
+        if failed.all():  # no subset to take: every scene has failed
+            extra_drag, extra_lift = self.failure.force_change(
+                penetration, obliquity, speed, failure_state, batch, self.resistance
+            )
+            return drag + extra_drag, lift + extra_lift
         if failed.any():
             index = np.flatnonzero(failed)
             extra_drag, extra_lift = self.failure.force_change(
@@ -124,6 +138,56 @@ class ImpactModel:
                 batch.take(index),
             )
         return rates
+
+    def rates(
+        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
+    ) -> np.ndarray:
+        """dy/dt for the state rows of :data:`PENETRATION` ... (eqs 25–30 in time form):
+        dP/dt = V cos θ, dY/dt = V sin θ, dθ/dt = lift/(m V) (0 where ``held`` at 180°),
+        dV/dt = −drag/m, then the failure state's rates."""
+        pen, obl, spd = y[PENETRATION], y[OBLIQUITY], y[SPEED]
+        failure_state = y[KINEMATIC_STATE:]
+        drag, lift = self.forces(pen, obl, spd, failed, failure_state, batch)
+        obliquity_rate = np.where(held, 0.0, lift / (batch.mass * spd))
+        dy = np.empty_like(y)
+        dy[PENETRATION] = spd * np.cos(obl)
+        dy[LATERAL] = spd * np.sin(obl)
+        dy[OBLIQUITY] = obliquity_rate
+        dy[SPEED] = -drag / batch.mass
+        dy[KINEMATIC_STATE:] = self.failure_state_rates(
+            pen, obl, spd, obliquity_rate, failed, failure_state, batch
+        )
+        return dy
+
+    def event_margins(
+        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
+    ) -> np.ndarray:
+        """Event functions, shape (5, n), rows :data:`ONSET` ... :data:`TURNED_BACK`.
+
+        Each crosses zero upward at its event and is −inf where the event cannot happen:
+        failure onset (P − P*, intact plates), contact lost (θ − π/2 − α1), perforation
+        (the failure model's margin, failed plates, while θ < π/2), rest (V_rest − V),
+        turned back (θ − π, not yet held).
+        """
+        return np.stack([self.event_margin(k, y, failed, held, batch) for k in range(5)])
+
+    def event_margin(
+        self, kind: int, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
+    ) -> np.ndarray:
+        """One row of :meth:`event_margins`."""
+        pen, obl = y[PENETRATION], y[OBLIQUITY]
+        if kind == ONSET:
+            return np.where(failed, -np.inf, pen - batch.onset_penetration)
+        if kind == CONTACT_LOST:
+            return contact_lost_margin(pen, obl, batch.radius)
+        if kind == PERFORATED:
+            margin = self.perforation_margin(pen, obl, failed, batch)
+            return np.where(obl < 0.5 * np.pi, margin, -np.inf)
+        if kind == AT_REST:
+            return batch.rest_speed - y[SPEED]
+        if kind == TURNED_BACK:
+            return np.where(held, -np.inf, obl - self.MAX_OBLIQUITY)
+        raise ValueError(f"no event {kind}")
 
     def perforation_margin(
         self,

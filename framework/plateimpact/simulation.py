@@ -16,7 +16,7 @@ from .scene import Scene
 
 DEFAULT_RESISTANCE = "poncelet"
 DEFAULT_FAILURE = "plugging"
-DEFAULT_INTEGRATOR = "segment"
+DEFAULT_INTEGRATOR = "dopri5"
 
 
 @attrs.frozen

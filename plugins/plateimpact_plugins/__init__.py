@@ -8,22 +8,28 @@ from __future__ import annotations
 
 from plateimpact import PluginRegistry, hookimpl
 
+from .dopri5 import DormandPrince54
+from .embedded_rk import EmbeddedRungeKutta
 from .hinge import Hinge
 from .intact import Intact
 from .plugging import Plugging
 from .poncelet import Poncelet
+from .scipy_ivp import ScipyIVP
 from .segment import Segment
 from .separation import PlaneSeparation
 from .variable_pstar import SAE1010_TABLE, PstarTable, VariablePstar
 
 __all__ = [
     "SAE1010_TABLE",
+    "DormandPrince54",
+    "EmbeddedRungeKutta",
     "Hinge",
     "Intact",
     "PlaneSeparation",
     "Plugging",
     "Poncelet",
     "PstarTable",
+    "ScipyIVP",
     "Segment",
     "VariablePstar",
     "plateimpact_register",
@@ -33,5 +39,14 @@ __all__ = [
 @hookimpl
 def plateimpact_register(registry: PluginRegistry) -> None:
     """Register the built-in resistance law, failure models and integrators."""
-    for cls in (Poncelet, Plugging, Hinge, VariablePstar, Intact, Segment):
+    for cls in (
+        Poncelet,
+        Plugging,
+        Hinge,
+        VariablePstar,
+        Intact,
+        Segment,
+        DormandPrince54,
+        ScipyIVP,
+    ):
         registry.add(cls)

@@ -105,7 +105,7 @@ class Segment(Integrator):
         failure_state = model.new_failure_state(batch.size)
         max_pen = np.zeros(batch.size)
         nominal_dt = self.step * batch.radius / batch.impact_speed
-        recorder.sample(scene, time, pen, lat, obl, spd, failure_state)
+        recorder.sample(scene, time, pen, lat, obl, spd, failure_state, failed)
 
         for _ in range(self.max_steps):
             drag, lift = model.forces(pen, obl, spd, failed, failure_state, batch)
@@ -137,7 +137,7 @@ class Segment(Integrator):
                 failed = failed | onset
                 model.start_failure(onset, pen, obl, spd, failure_state, batch)
                 recorder.failed(scene[onset], time[onset], pen[onset], lat[onset])
-            recorder.sample(scene, time, pen, lat, obl, spd, failure_state)
+            recorder.sample(scene, time, pen, lat, obl, spd, failure_state, failed)
 
             status = model.classify(pen, obl, failed, at_rest, batch)
             done = status > 0

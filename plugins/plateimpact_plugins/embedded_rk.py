@@ -1,0 +1,359 @@
+"""Adaptive embedded Runge–Kutta over a batch of scenes, with dense output and events."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import attrs
+import numpy as np
+
+from plateimpact import (
+    AT_REST,
+    CONTACT_LOST,
+    KINEMATIC_STATE,
+    LATERAL,
+    OBLIQUITY,
+    ONSET,
+    PENETRATION,
+    PERFORATED,
+    SPEED,
+    TURNED_BACK,
+    ImpactModel,
+    IntegrationError,
+    Integrator,
+    Outcome,
+    ParameterError,
+    ResultRecorder,
+    SceneBatch,
+)
+
+#: Where, inside an accepted step, event functions are sampled (fractions of the step).
+#: Sampling between the ends catches a margin that crosses and re-crosses in one step.
+EVENT_SAMPLES = np.linspace(0.0, 1.0, 5)
+BISECTIONS = 52  # halvings of the bracketing sub-step for the deepest point
+MAX_ROOT_ITERATIONS = 16  # Illinois converges superlinearly; more only chases rounding
+ROOT_TOLERANCE = 1e-13  # event time to this fraction of the step
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+#: Steps are limited to this fraction of Rs/Vs so that the first steps, taken while the
+#: force is still ~0, cannot leap across the contact.
+MAX_STEP = 0.5
+FIRST_STEP = 1e-2
+
+TERMINAL = {
+    CONTACT_LOST: Outcome.RICOCHET,
+    PERFORATED: Outcome.PERFORATION,
+    AT_REST: Outcome.EMBEDMENT,
+}
+
+
+def _combine(weights: np.ndarray, stages: np.ndarray) -> np.ndarray:
+    """Σ_j weights[j] · stages[j], element-wise in a fixed order, skipping zero weights
+    (so that a scene's result never depends on which other scenes share its batch)."""
+    total = np.zeros_like(stages[0])
+    for weight, stage in zip(weights, stages, strict=False):
+        if weight != 0.0:
+            total += weight * stage
+    return total
+
+
+def _check_rtol(instance: object, attribute: attrs.Attribute, value: float) -> None:
+    if not (isinstance(value, int | float) and 1e-14 <= value <= 1e-2):
+        raise ParameterError("rtol", f"rtol must be in [1e-14, 1e-2], got {value!r}")
+
+
+def _check_fixed_step(instance: object, attribute: attrs.Attribute, value: float | None) -> None:
+    if value is not None and not (isinstance(value, int | float) and 0.0 < value <= MAX_STEP):
+        raise ParameterError(
+            "fixed_step", f"fixed_step must be in (0, {MAX_STEP}] of Rs/Vs or None, got {value!r}"
+        )
+
+
+def _check_max_steps(instance: object, attribute: attrs.Attribute, value: int) -> None:
+    if not (isinstance(value, int) and value > 0):
+        raise ParameterError("max_steps", f"max_steps must be an integer > 0, got {value!r}")
+
+
+@attrs.frozen
+class EmbeddedRungeKutta(Integrator):
+    """Abstract: an explicit embedded Runge–Kutta pair with FSAL and dense output.
+
+    A subclass is data: the tableau ``C``, ``A``, ``B``, the error weights ``E`` (over all
+    stages, the last being the FSAL stage), the dense-output matrix ``P`` (stage weights
+    as polynomials in σ = (t − tn)/h, coefficients of σ, σ², ...), and ``error_order``.
+
+    Every scene has its own step size h, controlled so that the local error of every
+    state component stays below ``rtol`` × its scale (Rs for P and Y, 1 rad for θ and
+    failure state, Vs for V, or the component's own size if larger). All scenes advance
+    together, one step per iteration, as numpy arrays; finished scenes leave the set.
+
+    Events (``ImpactModel.event_margins``) are located in every accepted step on the dense
+    output: sampled at EVENT_SAMPLES, then bisected in the first sub-step where a margin
+    goes from < 0 to >= 0, to the last bit of the step. The step is cut there and the
+    integration restarts with the new force law (failure onset, θ held at 180°) or the
+    scene ends (contact lost, perforation, rest). The maximum penetration is located the
+    same way, where θ crosses 90°.
+    """
+
+    C: ClassVar[np.ndarray]
+    A: ClassVar[np.ndarray]
+    B: ClassVar[np.ndarray]
+    E: ClassVar[np.ndarray]
+    P: ClassVar[np.ndarray]
+    error_order: ClassVar[int]
+
+    rtol: float = attrs.field(default=1e-9, validator=_check_rtol)
+    max_steps: int = attrs.field(default=200_000, validator=_check_max_steps)
+    fixed_step: float | None = attrs.field(default=None, validator=_check_fixed_step)
+
+    def settings(self) -> dict[str, object]:
+        return {"rtol": self.rtol, "max_steps": self.max_steps, "fixed_step": self.fixed_step}
+
+    def _dense(
+        self, y: np.ndarray, h: np.ndarray, stages: np.ndarray, sigma: np.ndarray
+    ) -> np.ndarray:
+        """State at fractions ``sigma`` (shape (n,) or (n, m)) of the step: (d, n[, m])."""
+        if sigma.ndim == 2:
+            return np.stack(
+                [self._dense(y, h, stages, sigma[:, j]) for j in range(sigma.shape[1])], axis=-1
+            )
+        # Stage weights b_j(σ) = Σ_q P[j, q] σ^(q+1), summed stage by stage, element-wise.
+        total = np.zeros_like(y)
+        for j in range(stages.shape[0]):
+            if not self.P[j].any():
+                continue
+            weight = np.zeros_like(sigma)
+            for q in range(self.P.shape[1] - 1, -1, -1):
+                weight = (weight + self.P[j, q]) * sigma
+            total += weight * stages[j]
+        return y + h * total
+
+    def _integrate(self, model: ImpactModel, batch: SceneBatch, recorder: ResultRecorder) -> None:
+        n = batch.size
+        width = KINEMATIC_STATE + len(model.failure.state_names)
+        scene = np.arange(n)
+        y = np.zeros((width, n))  # failure state integrates zeros until onset sets it
+        y[PENETRATION], y[LATERAL] = 0.0, 0.0
+        y[OBLIQUITY], y[SPEED] = batch.impact_obliquity, batch.impact_speed
+        t = np.zeros(n)
+        failed, held = np.zeros(n, bool), np.zeros(n, bool)
+        max_pen = np.zeros(n)
+        unit = batch.radius / batch.impact_speed  # Rs/Vs [s]
+        h = (FIRST_STEP if self.fixed_step is None else self.fixed_step) * unit
+        char = np.ones((width, n))
+        char[PENETRATION] = char[LATERAL] = batch.radius
+        char[SPEED] = batch.impact_speed
+        k_first = model.rates(y, failed, held, batch)
+        recorder.stats["force_evaluations"] += n
+        recorder.sample(scene, t, *y[:KINEMATIC_STATE], y[KINEMATIC_STATE:], failed)
+        stages = np.empty((len(self.C) + 1, width, n))
+        exponent = -1.0 / self.error_order
+
+        for _ in range(self.max_steps):
+            recorder.stats["steps"] += 1
+            stages = stages[:, :, : y.shape[1]]
+            stages[0] = k_first
+            for i in range(1, len(self.C)):
+                stage_y = y + h * _combine(self.A[i, :i], stages)
+                stages[i] = model.rates(stage_y, failed, held, batch)
+            y_new = y + h * _combine(self.B, stages)
+            stages[-1] = model.rates(y_new, failed, held, batch)
+            recorder.stats["force_evaluations"] += len(self.C) * y.shape[1]
+            error = h * _combine(self.E, stages)
+            scale = self.rtol * np.maximum(char, np.maximum(np.abs(y), np.abs(y_new)))
+            with np.errstate(invalid="ignore"):
+                norm = np.max(np.abs(error) / scale, axis=0)
+            ok = np.isfinite(norm) & np.all(np.isfinite(y_new), axis=0) & (norm <= 1.0)
+            if self.fixed_step is not None:  # no error control: every finite step stands
+                ok = np.all(np.isfinite(y_new), axis=0)
+                norm = np.ones_like(norm)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                factor = np.clip(SAFETY * norm**exponent, MIN_FACTOR, MAX_FACTOR)
+            factor = np.where(np.isfinite(factor), factor, MIN_FACTOR)
+            if not ok.any():
+                h = h * np.minimum(factor, 1.0)
+                continue
+
+            # Accepted scenes: sample the step, find the first event in it.
+            idx = np.flatnonzero(ok)
+            sub = batch.take(idx)
+            y0, h0, k = y[:, idx], h[idx], stages[:, :, idx]
+            sigma = np.broadcast_to(EVENT_SAMPLES, (idx.size, EVENT_SAMPLES.size))
+            samples = self._dense(y0, h0, k, sigma)  # (d, m, s)
+            margins = np.stack(
+                [
+                    model.event_margins(samples[:, :, j], failed[idx], held[idx], sub)
+                    for j in range(EVENT_SAMPLES.size)
+                ],
+                axis=-1,
+            )  # (events, m, s)
+            crossing = (margins[:, :, :-1] < 0.0) & (margins[:, :, 1:] >= 0.0)
+            event_sigma = np.full(idx.size, np.inf)
+            event_kind = np.full(idx.size, -1)
+            for kind in range(margins.shape[0]):
+                has = crossing[kind].any(axis=1)
+                if not has.any():
+                    continue
+                rows = np.flatnonzero(has)
+                first = np.argmax(crossing[kind, rows], axis=1)
+                located = self._locate(
+                    model,
+                    kind,
+                    y0[:, rows],
+                    h0[rows],
+                    k[:, :, rows],
+                    EVENT_SAMPLES[first],
+                    EVENT_SAMPLES[first + 1],
+                    margins[kind, rows, first],
+                    margins[kind, rows, first + 1],
+                    failed[idx][rows],
+                    held[idx][rows],
+                    sub.take(rows),
+                )
+                earlier = located < event_sigma[rows]
+                event_sigma[rows[earlier]] = located[earlier]
+                event_kind[rows[earlier]] = kind
+            hit = np.isfinite(event_sigma)
+            end_sigma = np.where(hit, event_sigma, 1.0)
+            y_end = np.where(hit, self._dense(y0, h0, k, end_sigma), y_new[:, idx])
+            t_end = t[idx] + end_sigma * h0
+
+            # Maximum penetration: P at the samples, and where θ crosses 90° upward.
+            inside = EVENT_SAMPLES[np.newaxis, :] <= end_sigma[:, np.newaxis]
+            peak = np.max(np.where(inside, samples[PENETRATION], -np.inf), axis=1)
+            peak = np.maximum(peak, y_end[PENETRATION])
+            turning = (
+                (samples[OBLIQUITY][:, :-1] < 0.5 * np.pi)
+                & (samples[OBLIQUITY][:, 1:] >= 0.5 * np.pi)
+                & inside[:, 1:]
+            )
+            if turning.any():
+                rows = np.flatnonzero(turning.any(axis=1))
+                first = np.argmax(turning[rows], axis=1)
+                crest_sigma, crest = self._bisect_obliquity(
+                    y0[:, rows],
+                    h0[rows],
+                    k[:, :, rows],
+                    EVENT_SAMPLES[first],
+                    EVENT_SAMPLES[first + 1],
+                )
+                peak[rows] = np.maximum(peak[rows], crest[PENETRATION])
+                if recorder.record_trajectory:  # the deepest point belongs to the path
+                    recorder.sample(
+                        scene[idx[rows]],
+                        t[idx[rows]] + crest_sigma * h0[rows],
+                        *crest[:KINEMATIC_STATE],
+                        crest[KINEMATIC_STATE:],
+                        failed[idx[rows]],
+                    )
+            max_pen[idx] = np.maximum(max_pen[idx], peak)
+            if recorder.record_trajectory:
+                for j in range(1, EVENT_SAMPLES.size):
+                    keep = EVENT_SAMPLES[j] < end_sigma
+                    if keep.any():
+                        s_y = samples[:, keep, j]
+                        recorder.sample(
+                            scene[idx[keep]],
+                            t[idx[keep]] + EVENT_SAMPLES[j] * h0[keep],
+                            *s_y[:KINEMATIC_STATE],
+                            s_y[KINEMATIC_STATE:],
+                            failed[idx[keep]],
+                        )
+                recorder.sample(
+                    scene[idx],
+                    t_end,
+                    *y_end[:KINEMATIC_STATE],
+                    y_end[KINEMATIC_STATE:],
+                    failed[idx],
+                )
+
+            # Advance: full steps keep the FSAL stage; cut steps restart from the event.
+            y[:, idx], t[idx] = y_end, t_end
+            k_first[:, idx] = stages[-1][:, idx]
+            h = h * np.where(ok, factor, np.minimum(factor, 1.0))
+            status = np.zeros(y.shape[1], dtype=np.int8)
+            events = idx[hit]
+            kinds = event_kind[hit]
+            for kind, outcome in TERMINAL.items():
+                status[events[kinds == kind]] = outcome
+            onset = events[kinds == ONSET]
+            if onset.size:
+                mask = np.zeros(y.shape[1], bool)
+                mask[onset] = True
+                failed = failed | mask
+                state = y[KINEMATIC_STATE:]
+                model.start_failure(mask, y[PENETRATION], y[OBLIQUITY], y[SPEED], state, batch)
+                y[KINEMATIC_STATE:] = state
+                recorder.failed(scene[onset], t[onset], y[PENETRATION, onset], y[LATERAL, onset])
+            turned = events[kinds == TURNED_BACK]
+            if turned.size:
+                held[turned] = True
+                y[OBLIQUITY, turned] = ImpactModel.MAX_OBLIQUITY
+            restart = events[(kinds == ONSET) | (kinds == TURNED_BACK)]
+            if restart.size:
+                k_first[:, restart] = model.rates(
+                    y[:, restart], failed[restart], held[restart], batch.take(restart)
+                )
+                recorder.stats["force_evaluations"] += restart.size
+
+            done = status > 0
+            if done.any():
+                exit_speed = np.where(status[done] == Outcome.EMBEDMENT, 0.0, y[SPEED, done])
+                recorder.finish(
+                    scene[done],
+                    status[done],
+                    exit_speed,
+                    y[OBLIQUITY, done],
+                    t[done],
+                    max_pen[done],
+                )
+                keep = ~done
+                if not keep.any():
+                    return
+                scene, batch = scene[keep], batch.take(keep)
+                y, t, h, k_first = y[:, keep], t[keep], h[keep], k_first[:, keep]
+                failed, held, max_pen = failed[keep], held[keep], max_pen[keep]
+                char, unit = char[:, keep], unit[keep]
+            h = np.minimum(h, MAX_STEP * unit)
+            if self.fixed_step is not None:
+                h = self.fixed_step * unit
+        raise IntegrationError(
+            f"{self.name}: {scene.size} scene(s) unfinished after max_steps={self.max_steps} "
+            f"steps (first: scene {int(scene[0])}); raise max_steps or rtol"
+        )
+
+    def _locate(self, model, kind, y0, h0, k, lo, hi, f_lo, f_hi, failed, held, batch):
+        """σ in (lo, hi] where event ``kind`` first has margin >= 0.
+
+        Illinois (modified regula falsi) on the dense output, bisection where a margin is
+        not finite. Each row stops once its bracket is below ROOT_TOLERANCE of the step,
+        so a scene's event time never depends on the other scenes of its batch.
+        """
+        lo, hi, f_lo, f_hi = lo.copy(), hi.copy(), f_lo.copy(), f_hi.copy()
+        side = np.zeros(lo.size)
+        for _ in range(MAX_ROOT_ITERATIONS):
+            open_ = hi - lo > ROOT_TOLERANCE
+            if not open_.any():
+                break
+            usable = np.isfinite(f_lo) & np.isfinite(f_hi) & (f_hi > f_lo)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                secant = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+            x = np.where(usable & (secant > lo) & (secant < hi), secant, 0.5 * (lo + hi))
+            f = model.event_margin(kind, self._dense(y0, h0, k, x), failed, held, batch)
+            after = (f >= 0.0) & open_
+            before = ~(f >= 0.0) & open_
+            f_lo = np.where(after & (side > 0), 0.5 * f_lo, f_lo)  # Illinois: an end kept
+            f_hi = np.where(before & (side < 0), 0.5 * f_hi, f_hi)  # twice loses weight
+            hi, f_hi = np.where(after, x, hi), np.where(after, f, f_hi)
+            lo, f_lo = np.where(before, x, lo), np.where(before, f, f_lo)
+            side = np.where(after, 1.0, np.where(before, -1.0, side))
+        return hi
+
+    def _bisect_obliquity(self, y0, h0, k, lo, hi) -> np.ndarray:
+        """State where θ crosses 90° upward between σ = lo and hi: the deepest point."""
+        lo, hi = lo.astype(float).copy(), hi.astype(float).copy()
+        for _ in range(BISECTIONS):
+            mid = 0.5 * (lo + hi)
+            after = self._dense(y0, h0, k, mid)[OBLIQUITY] >= 0.5 * np.pi
+            hi = np.where(after, mid, hi)
+            lo = np.where(after, lo, mid)
+        return hi, self._dense(y0, h0, k, hi)
