@@ -54,7 +54,8 @@ def test_thin_plate_ricochets_after_failure_just_below_embedment():
     )
     assert re.fullmatch("i+b+E+P+", kinds), kinds
     band_speed, band_obliquity = result.exit_speed[band], result.exit_obliquity[band]
-    assert np.all(np.diff(band_speed) < 0.0) and np.all(np.diff(band_obliquity) > 0.0)
+    # Exit speed falls all the way; exit obliquity climbs (to 180°, where it is held).
+    assert np.all(np.diff(band_speed) < 0.0) and np.all(np.diff(band_obliquity) >= 0.0)
     assert band_speed[-1] < 0.5 * result.exit_speed[intact].max()
     assert band_obliquity.min() > result.exit_obliquity[intact].max()
 
