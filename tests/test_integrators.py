@@ -1,0 +1,150 @@
+"""Integrators: convergence order, event location, agreement with the scipy reference."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import plateimpact as pi
+from plateimpact import presets
+from plateimpact.units import deg
+
+SPHERE = presets.DEFAULT_SPHERE
+PLATE = presets.plate("6061-T6/9.53")
+SLOW = 100.0  # [m/s]: at normal incidence it stops before P = Rs, where A(P) is smooth
+
+
+def closed_form_rest_depth(speed, rest_fraction=0.01):
+    """P where V falls to the rest speed at normal incidence, P <= Rs (energy integral)."""
+    rs, m, a, b = SPHERE.radius, SPHERE.mass, PLATE.a, PLATE.b
+    target = m / (2 * b) * np.log((a + b * speed**2) / (a + b * (rest_fraction * speed) ** 2))
+    return brentq(lambda p: np.pi * (rs * p**2 - p**3 / 3) - target, 0.0, rs, xtol=1e-18)
+
+
+def normal_incidence_error(integrator, **settings):
+    simulation = pi.Simulation.from_names(
+        failure="intact", integrator=integrator, integrator_settings=settings
+    )
+    result = simulation.run(pi.Scene(SPHERE, PLATE, SLOW, 0.0))
+    exact = closed_form_rest_depth(SLOW)
+    return abs(result.max_penetration - exact) / exact
+
+
+def observed_order(errors, refinements):
+    return np.polyfit(np.log(refinements), np.log(errors), 1)[0]
+
+
+def test_dormand_prince_is_fifth_order_at_fixed_step():
+    steps = np.array([0.2, 0.1, 0.05, 0.025])
+    errors = [normal_incidence_error("dopri5", fixed_step=s) for s in steps]
+    assert 4.5 < observed_order(errors, steps) < 6.0, errors
+
+
+def test_segment_is_first_order():
+    steps = np.array([4e-3, 2e-3, 1e-3])
+    errors = [normal_incidence_error("segment", step=s) for s in steps]
+    assert 0.85 < observed_order(errors, steps) < 1.15, errors
+
+
+@pytest.mark.parametrize(
+    ("integrator", "method"),
+    [("dopri5", None), ("solve_ivp", "DOP853"), ("solve_ivp", "RK45"), ("solve_ivp", "LSODA")],
+)
+def test_adaptive_error_falls_with_the_tolerance(integrator, method):
+    # Tolerance proportionality: a hundred times tighter, the error falls by at least ~30.
+    extra = {} if method is None else {"method": method}
+    loose = normal_incidence_error(integrator, rtol=1e-5, **extra)
+    tight = normal_incidence_error(integrator, rtol=1e-7, **extra)
+    assert tight < loose / 30 or tight < 1e-11, (loose, tight)
+
+
+SCENES = [
+    ("6061-T6/9.53", 300.0, 45.0),  # ricochet
+    ("6061-T6/9.53", 1200.0, 45.0),  # perforation
+    ("2024-T3/3.18", 660.0, 60.0),  # ricochet after failure
+    ("2024-T3/1.27", 207.0, 45.0),  # embedment after failure (2.5-m/s-wide range)
+    ("SAE1010/1.47", 700.0, 60.0),
+    ("2024-T3/6.35", 800.0, 30.0),
+    ("6061-T6/9.53", 474.0, 9.5),  # shallow embedment, ψ ≠ 0 at rest
+    ("6061-T6/9.53", 550.0, 20.0),  # ricochet that reaches 180°
+]
+
+
+@pytest.fixture(scope="module")
+def scenes():
+    return [pi.Scene(SPHERE, presets.plate(p), v, o * deg) for p, v, o in SCENES]
+
+
+@pytest.fixture(scope="module")
+def reference(scenes):
+    simulation = pi.Simulation.from_names(
+        integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
+    )
+    return simulation.run_batch(scenes)
+
+
+def test_default_integrator_meets_its_accuracy_target(scenes, reference):
+    # The default (dopri5, rtol 1e-9) against DOP853 at rtol 1e-12: exit speed within
+    # 1e-6 of the impact speed, exit obliquity within 1e-4°, same outcomes.
+    result = pi.Simulation.from_names().run_batch(scenes)
+    speed = np.array([s.impact_speed for s in scenes])
+    np.testing.assert_array_equal(result.outcome, reference.outcome)
+    assert np.max(np.abs(result.exit_speed - reference.exit_speed) / speed) <= 1e-6
+    flying = reference.outcome != pi.Outcome.EMBEDMENT
+    assert (
+        np.degrees(np.max(np.abs(result.exit_obliquity - reference.exit_obliquity)[flying])) <= 1e-4
+    )
+    np.testing.assert_allclose(result.max_penetration, reference.max_penetration, rtol=1e-7)
+
+
+@pytest.mark.parametrize("integrator", ["dopri5", "solve_ivp"])
+def test_events_are_located_on_their_surfaces(integrator, scenes):
+    # Failure starts at P = P*, rest is reached at V = f·Vs, a ricochet leaves where the
+    # contact-lost margin is zero: events are located, not stepped over.
+    simulation = pi.Simulation.from_names(integrator=integrator)
+    result = simulation.run_batch(scenes, record_trajectory=True)
+    pstar = np.array([s.plate.critical_penetration for s in scenes])
+    failed = result.plate_failed
+    np.testing.assert_allclose(result.failure_penetration[failed], pstar[failed], rtol=1e-9)
+    for i, scene in enumerate(scenes):
+        t = result.trajectory_of(i)
+        if result.outcome[i] == pi.Outcome.EMBEDMENT:
+            assert t.speed[-1] == pytest.approx(0.01 * scene.impact_speed, rel=1e-9)
+        if result.outcome[i] == pi.Outcome.RICOCHET:
+            margin = pi.contact_lost_margin(
+                t.penetration[-1:], t.obliquity[-1:], np.array([SPHERE.radius])
+            )
+            assert abs(margin[0]) < 1e-8
+
+
+def test_rest_direction_converges_with_the_tolerance():
+    # A shallow embedment keeps turning as V → 0 (dθ/d ln V = −tan ψ), which amplifies
+    # errors; the rest rule still makes its final direction converge, ~10x per decade.
+    scene = pi.Scene(SPHERE, PLATE, 474.0, 9.5 * deg)
+    reference = (
+        pi.Simulation.from_names(integrator="solve_ivp", integrator_settings={"rtol": 1e-12})
+        .run(scene)
+        .exit_obliquity
+    )
+    errors = [
+        abs(
+            pi.Simulation.from_names(integrator_settings={"rtol": r}).run(scene).exit_obliquity
+            - reference
+        )
+        for r in (1e-6, 1e-8, 1e-10)
+    ]
+    assert errors[1] < errors[0] / 30 and errors[2] < errors[1] / 30, errors
+    assert np.degrees(pi.Simulation.from_names().run(scene).exit_obliquity - reference) < 1e-4
+
+
+def test_bad_integrator_settings_name_the_setting():
+    for name, settings, parameter in [
+        ("dopri5", {"rtol": 0.5}, "rtol"),
+        ("dopri5", {"fixed_step": 2.0}, "fixed_step"),
+        ("solve_ivp", {"method": "Euler"}, "method"),
+        ("solve_ivp", {"rtol": 0.0}, "rtol"),
+    ]:
+        with pytest.raises(pi.ParameterError) as info:
+            pi.Simulation.from_names(integrator=name, integrator_settings=settings)
+        assert info.value.parameter == parameter
