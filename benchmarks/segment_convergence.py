@@ -66,7 +66,9 @@ def main() -> None:
         for i in range(20)
     ]
     fine = [
-        pi.Simulation.from_names(integrator_settings={"step": s}).run_batch(oblique)
+        pi.Simulation.from_names(integrator="segment", integrator_settings={"step": s}).run_batch(
+            oblique
+        )
         for s in REFERENCE_STEPS
     ]
     ref_speed = 2 * fine[1].exit_speed - fine[0].exit_speed
@@ -79,8 +81,12 @@ def main() -> None:
         f" {'mismatch':>8s} {'ms/scene':>9s} {'evals/scene':>11s}"
     )
     for step in STEPS:
-        intact = pi.Simulation.from_names(failure="intact", integrator_settings={"step": step})
-        plugging = pi.Simulation.from_names(integrator_settings={"step": step})
+        intact = pi.Simulation.from_names(
+            failure="intact", integrator="segment", integrator_settings={"step": step}
+        )
+        plugging = pi.Simulation.from_names(
+            integrator="segment", integrator_settings={"step": step}
+        )
         n_res, _ = timed(intact, normal, repeats=1)
         o_res, per_scene = timed(plugging, oblique)
         p_err = np.max(np.abs(n_res.max_penetration - exact) / exact)

@@ -1,7 +1,7 @@
 """Outcome ranges of the report's five plates: where a 6.35-mm steel sphere ricochets,
 embeds or perforates, by obliquity (the ranges the 1976 computation had to find first).
 
-Run:  python studies/outcome_ranges.py [--step 1e-3]
+Run:  python studies/outcome_ranges.py [--integrator dopri5|segment|solve_ivp]
 
 Prints, per plate and obliquity, the impact-speed ranges [m/s] of each outcome on a
 25 m/s grid, marking ricochets after plate failure (the thin-plate band) with "*".
@@ -35,10 +35,10 @@ def ranges(outcome: np.ndarray, failed: np.ndarray) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--step", type=float, default=1e-3, help="segment step (fraction of Rs/Vs)")
+    parser.add_argument("--integrator", default="dopri5", help="integrator by name")
     args = parser.parse_args()
 
-    simulation = pi.Simulation.from_names(integrator_settings={"step": args.step})
+    simulation = pi.Simulation.from_names(integrator=args.integrator)
     cases = list(itertools.product(presets.PLATES, OBLIQUITIES))
     batch = pi.SceneBatch.concat(
         pi.SceneBatch.grid(presets.DEFAULT_SPHERE, presets.plate(name), SPEEDS, [np.radians(ob)])
@@ -54,8 +54,8 @@ def main() -> None:
         outcome_ranges = ranges(result.outcome[part], result.plate_failed[part])
         print(f"{name:14s} {obliquity:4.0f}°  {outcome_ranges}")
     print(
-        f"\n{batch.size} scenes in {elapsed:.1f} s ({simulation.integrator.name}, "
-        f"step {args.step:g}); R* = ricochet after plate failure"
+        f"\n{batch.size} scenes in {elapsed:.1f} s ({simulation.integrator.name} "
+        f"{simulation.integrator.settings()}); R* = ricochet after plate failure"
     )
 
 

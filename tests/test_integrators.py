@@ -149,3 +149,19 @@ def test_bad_integrator_settings_name_the_setting():
         with pytest.raises(pi.ParameterError) as info:
             pi.Simulation.from_names(integrator=name, integrator_settings=settings)
         assert info.value.parameter == parameter
+
+
+def test_threads_change_no_result():
+    # Large batches are split across threads; scenes are independent, so bit-identical.
+    rng = np.random.default_rng(11)
+    batch = pi.SceneBatch.grid(
+        SPHERE, presets.plate("2024-T3/3.18"), rng.uniform(50, 1500, 1200), [0.0]
+    )
+    batch = batch.with_columns(impact_obliquity=np.radians(rng.uniform(0, 70, batch.size)))
+    simulation = pi.Simulation.from_names()
+    one = simulation.run_batch(batch, threads=1, record_trajectory=True)
+    two = simulation.run_batch(batch, threads=2, record_trajectory=True)
+    for name, column in one.columns.items():
+        np.testing.assert_array_equal(column, two.columns[name], err_msg=name)
+    for name, column in one.trajectory.items():
+        np.testing.assert_array_equal(column, two.trajectory[name], err_msg=name)

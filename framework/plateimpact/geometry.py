@@ -109,15 +109,19 @@ def contact_geometry(
     re_squared = embedment_radius_squared(penetration, radius)
     sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
     # eq 4, (Rs − P)/(Re tan θ) written with sin and cos so that θ = 0 is a limit.
-    ratio_e = _limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t)
-    gamma_e = TWO_PI - 2.0 * np.arccos(np.clip(ratio_e, -1.0, 1.0))
-    ratio_s = _limit_ratio(centre_height, radius * sin_t)  # eq 5
-    gamma_s = 2.0 * np.arccos(np.clip(ratio_s, -1.0, 1.0))
+    ratio_e = np.clip(_limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t), -1.0, 1.0)
+    ratio_s = np.clip(_limit_ratio(centre_height, radius * sin_t), -1.0, 1.0)  # eq 5
+    # Γ − sin Γ for Γe = 2π − 2 arccos r and Γs = 2 arccos r, with sin(2 arccos r) written
+    # as 2 r √(1 − r²): the same values without two more sine evaluations.
+    chord_e = 2.0 * ratio_e * np.sqrt(1.0 - ratio_e * ratio_e)
+    chord_s = 2.0 * ratio_s * np.sqrt(1.0 - ratio_s * ratio_s)
+    segment_e = TWO_PI - 2.0 * np.arccos(ratio_e) + chord_e  # Γe − sin Γe
+    segment_s = 2.0 * np.arccos(ratio_s) - chord_s  # Γs − sin Γs
 
     phi = force_inclination(penetration, obliquity, radius)
-    area = 0.5 * re_squared * (gamma_e - np.sin(gamma_e)) * np.cos(phi) + 0.5 * radius**2 * (
-        gamma_s - np.sin(gamma_s)
-    ) * np.cos(obliquity - phi)  # eq 2
+    area = 0.5 * re_squared * segment_e * np.cos(phi) + 0.5 * radius**2 * segment_s * np.cos(
+        obliquity - phi
+    )  # eq 2
     return area, phi
 
 

@@ -145,6 +145,19 @@ class BatchResult:
         if trajectory_counts is not None:
             self.trajectory_offsets = np.concatenate([[0], np.cumsum(trajectory_counts)])
 
+    @classmethod
+    def concat(cls, parts: list[BatchResult]) -> BatchResult:
+        """One result holding ``parts`` in order (e.g. the chunks of a threaded run)."""
+        columns = {k: np.concatenate([p.columns[k] for p in parts]) for k in parts[0].columns}
+        stats = {k: sum(p.stats.get(k, 0) for p in parts) for k in parts[0].stats}
+        if parts[0].trajectory is None:
+            return cls(columns, stats=stats)
+        trajectory = {
+            k: np.concatenate([p.trajectory[k] for p in parts]) for k in parts[0].trajectory
+        }
+        counts = np.concatenate([p.trajectory_counts for p in parts])
+        return cls(columns, trajectory, counts, stats)
+
     def __len__(self) -> int:
         return self.columns["outcome"].size
 

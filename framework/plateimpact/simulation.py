@@ -53,11 +53,18 @@ class Simulation:
         return cls(model, registry.create("integrator", integrator, **(integrator_settings or {})))
 
     def run_batch(
-        self, scenes: SceneBatch | Iterable[Scene], *, record_trajectory: bool = False
+        self,
+        scenes: SceneBatch | Iterable[Scene],
+        *,
+        record_trajectory: bool = False,
+        threads: int | None = None,
     ) -> BatchResult:
-        """Results of many scenes, as arrays in the order given."""
+        """Results of many scenes, as arrays in the order given (``threads``: see
+        :meth:`Integrator.run`; default one per CPU)."""
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
-        return self.integrator.run(self.model, batch, record_trajectory=record_trajectory)
+        return self.integrator.run(
+            self.model, batch, record_trajectory=record_trajectory, threads=threads
+        )
 
     def run(self, scene: Scene, *, record_trajectory: bool = False) -> Result:
         """The result of one scene."""

@@ -1,0 +1,85 @@
+"""Wall time of a 10,000-scene sweep with the default integrator, and what each skip saves.
+
+  * the sweep: minimum of 3 runs after a warm-up;
+  * trajectories: the same sweep recording them (they are off unless asked for);
+  * failure terms: one force evaluation on 10,000 states of which a fifth have failed,
+    computing the failure terms only for those (what the model does) and for every scene;
+  * crater sections: the cost per scene of the crater, computed only on request.
+
+Run:  python benchmarks/throughput.py [--scenes 10000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from scenes import benchmark_batch
+
+import plateimpact as pi
+from plateimpact.crater import crater_section
+
+
+def best_of(function, repeats=3):
+    function()  # warm-up
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=10_000)
+    args = parser.parse_args()
+    batch = benchmark_batch(args.scenes, seed=10_000)
+    simulation = pi.Simulation.from_names()
+    print(f"integrator: {simulation.integrator.name} {simulation.integrator.settings()}")
+
+    sweep = best_of(lambda: simulation.run_batch(batch))
+    result = simulation.run_batch(batch)
+    counts = np.bincount(result.outcome, minlength=4)[1:]
+    print(
+        f"sweep of {batch.size} scenes: {sweep:.2f} s wall "
+        f"({sweep / batch.size * 1e6:.0f} us per scene; ricochet/embedment/perforation "
+        f"{'/'.join(map(str, counts))})"
+    )
+
+    recorded = best_of(lambda: simulation.run_batch(batch, record_trajectory=True), repeats=1)
+    print(f"with trajectories recorded: {recorded:.2f} s (+{(recorded / sweep - 1) * 100:.0f}%)")
+
+    model = simulation.model
+    bound = model.bind(batch)
+    rng = np.random.default_rng(1)
+    pen = rng.uniform(0.0, 2.0, batch.size) * bound.radius
+    obl = rng.uniform(0.0, np.pi / 2, batch.size)
+    spd = bound.impact_speed * rng.uniform(0.1, 1.0, batch.size)
+    state = model.new_failure_state(batch.size)
+    some = rng.uniform(size=batch.size) < 0.2
+    every = np.ones(batch.size, bool)
+    only_failed = best_of(lambda: model.forces(pen, obl, spd, some, state, bound), repeats=20)
+    intact_only = best_of(lambda: model.forces(pen, obl, spd, ~every, state, bound), repeats=20)
+    all_terms = best_of(lambda: model.forces(pen, obl, spd, every, state, bound), repeats=20)
+    print(
+        f"force evaluation, 10,000 states: intact {intact_only * 1e3:.2f} ms; 20% failed "
+        f"{only_failed * 1e3:.2f} ms; failure terms for every scene {all_terms * 1e3:.2f} ms "
+        f"(skipping saves {(1 - only_failed / all_terms) * 100:.0f}%)"
+    )
+
+    sample = batch.take(np.arange(50))
+    paths = simulation.run_batch(sample, record_trajectory=True)
+    radius = sample.radius
+    crater = best_of(
+        lambda: [crater_section(paths.trajectory_of(i), radius[i]) for i in range(sample.size)],
+        repeats=1,
+    )
+    print(
+        f"crater section: {crater / sample.size * 1e3:.1f} ms per scene, computed only on request"
+    )
+
+
+if __name__ == "__main__":
+    main()

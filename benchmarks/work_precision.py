@@ -1,0 +1,145 @@
+"""Work-precision of every integrator on 500 seeded scenes.
+
+Reference: solve_ivp DOP853 at rtol 1e-12, cross-checked by dopri5 at rtol 1e-12 (their
+largest disagreement is printed). For each integrator and tolerance (or step): max and
+median error of exit speed relative to impact speed, max and median error of exit
+obliquity [deg] (embedments excluded), outcome mismatches, time per scene (minimum of
+several runs after a warm-up) and right-hand-side evaluations per scene.
+
+Writes benchmarks/results/work_precision.csv and .png.
+
+Run:  python benchmarks/work_precision.py [--scenes 500]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import time
+from pathlib import Path
+
+import numpy as np
+from scenes import benchmark_batch
+
+import plateimpact as pi
+from plateimpact import plotting
+
+RESULTS = Path(__file__).resolve().parent / "results"
+CONFIGS = (
+    [("segment", {"step": s}) for s in (1e-2, 3e-3, 1e-3, 3e-4)]
+    + [("dopri5", {"rtol": r}) for r in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)]
+    + [("solve_ivp", {"method": "DOP853", "rtol": r}) for r in (1e-6, 1e-8, 1e-10)]
+    + [("solve_ivp", {"method": "RK45", "rtol": r}) for r in (1e-6, 1e-8)]
+    + [("solve_ivp", {"method": "LSODA", "rtol": r}) for r in (1e-6, 1e-8)]
+)
+
+
+def timed(simulation, batch, repeats):
+    simulation.run_batch(batch.take(np.arange(min(10, batch.size))))  # warm-up
+    best, result = np.inf, None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = simulation.run_batch(batch)
+        best = min(best, time.perf_counter() - start)
+    return result, best / batch.size
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=500)
+    args = parser.parse_args()
+    batch = benchmark_batch(args.scenes)
+    speed = batch.impact_speed
+
+    start = time.perf_counter()
+    reference = pi.Simulation.from_names(
+        integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
+    ).run_batch(batch)
+    print(f"reference DOP853 rtol 1e-12: {time.perf_counter() - start:.0f} s")
+    check = pi.Simulation.from_names(integrator_settings={"rtol": 1e-12}).run_batch(batch)
+    flying = (reference.outcome != pi.Outcome.EMBEDMENT) & (check.outcome != pi.Outcome.EMBEDMENT)
+    obliquity_gap = np.degrees(
+        np.max(np.abs(check.exit_obliquity - reference.exit_obliquity)[flying])
+    )
+    print(
+        "cross-check dopri5 rtol 1e-12: outcome mismatches "
+        f"{int(np.sum(check.outcome != reference.outcome))}, max |Δ exit speed|/Vs "
+        f"{np.max(np.abs(check.exit_speed - reference.exit_speed) / speed):.1e}, max |Δ exit "
+        f"obliquity| {obliquity_gap:.1e} deg"
+    )
+
+    rows = []
+    header = (
+        "integrator",
+        "setting",
+        "value",
+        "max_speed_error",
+        "median_speed_error",
+        "max_obliquity_error_deg",
+        "median_obliquity_error_deg",
+        "outcome_mismatches",
+        "time_per_scene_s",
+        "rhs_evaluations_per_scene",
+    )
+    print(" ".join(f"{h:>14s}" for h in header))
+    for name, settings in CONFIGS:
+        simulation = pi.Simulation.from_names(integrator=name, integrator_settings=settings)
+        repeats = 2 if name == "solve_ivp" else 3
+        result, per_scene = timed(simulation, batch, repeats)
+        speed_error = np.abs(result.exit_speed - reference.exit_speed) / speed
+        flying = (reference.outcome != pi.Outcome.EMBEDMENT) & (
+            result.outcome != pi.Outcome.EMBEDMENT
+        )
+        obliquity_error = np.degrees(
+            np.abs(result.exit_obliquity - reference.exit_obliquity)[flying]
+        )
+        label = "method" if name == "solve_ivp" else ("step" if name == "segment" else "rtol")
+        setting = f"{settings.get('method', '')} {label if label != 'method' else 'rtol'}".strip()
+        value = settings.get("step", settings.get("rtol"))
+        row = (
+            name,
+            setting,
+            value,
+            speed_error.max(),
+            np.median(speed_error),
+            obliquity_error.max(),
+            np.median(obliquity_error),
+            int(np.sum(result.outcome != reference.outcome)),
+            per_scene,
+            result.stats["force_evaluations"] / batch.size,
+        )
+        rows.append(row)
+        print(" ".join(f"{x:>14.3g}" if isinstance(x, float) else f"{x!s:>14s}" for x in row))
+
+    RESULTS.mkdir(exist_ok=True)
+    with open(RESULTS / "work_precision.csv", "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(header)
+        writer.writerows(rows)
+
+    fig, axes = plotting.plt.subplots(1, 2, figsize=(12, 4.8))
+    for key in dict.fromkeys((r[0], r[1].split()[0] if r[0] == "solve_ivp" else "") for r in rows):
+        series = [r for r in rows if (r[0], r[1].split()[0] if r[0] == "solve_ivp" else "") == key]
+        label = " ".join(k for k in key if k)
+        for ax, column in zip(axes, (3, 5), strict=True):
+            ax.loglog(
+                [max(r[column], 1e-16) for r in series], [r[8] for r in series], "o-", label=label
+            )
+    axes[0].set_xlabel("max exit-speed error / impact speed")
+    axes[1].set_xlabel("max exit-obliquity error [deg]")
+    for ax in axes:
+        ax.set_ylabel("time per scene [s]")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].axvline(1e-6, color="0.5", ls=":")
+    axes[1].axvline(1e-4, color="0.5", ls=":")
+    axes[0].legend()
+    fig.suptitle(
+        f"Work-precision, {batch.size} scenes (reference: DOP853 at rtol 1e-12); "
+        "dotted: the default's targets"
+    )
+    plotting.save(fig, str(RESULTS / "work_precision.png"))
+    print(f"wrote {RESULTS / 'work_precision.csv'} and work_precision.png")
+
+
+if __name__ == "__main__":
+    main()
