@@ -86,7 +86,7 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
         "--rtol",
         type=float,
         help="for adaptive integrators (dopri5, solve_ivp): relative tolerance "
-        "(dopri5 default 1e-9)",
+        "(dopri5 default 1e-10)",
     )
 
 

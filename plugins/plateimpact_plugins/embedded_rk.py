@@ -101,7 +101,7 @@ class EmbeddedRungeKutta(Integrator):
     P: ClassVar[np.ndarray]
     error_order: ClassVar[int]
 
-    rtol: float = attrs.field(default=1e-9, validator=_check_rtol)
+    rtol: float = attrs.field(default=1e-10, validator=_check_rtol)
     max_steps: int = attrs.field(default=200_000, validator=_check_max_steps)
     fixed_step: float | None = attrs.field(default=None, validator=_check_fixed_step)
 
