@@ -151,17 +151,23 @@ def test_bad_integrator_settings_name_the_setting():
         assert info.value.parameter == parameter
 
 
-def test_threads_change_no_result():
-    # Large batches are split across threads; scenes are independent, so bit-identical.
+def test_chunks_concatenate_to_the_whole():
+    # Results of contiguous chunks, concatenated, are the results of the whole batch
+    # (how a study splits work across processes), trajectories included.
     rng = np.random.default_rng(11)
     batch = pi.SceneBatch.grid(
-        SPHERE, presets.plate("2024-T3/3.18"), rng.uniform(50, 1500, 1200), [0.0]
+        SPHERE, presets.plate("2024-T3/3.18"), rng.uniform(50, 1500, 60), [0.0]
     )
     batch = batch.with_columns(impact_obliquity=np.radians(rng.uniform(0, 70, batch.size)))
     simulation = pi.Simulation.from_names()
-    one = simulation.run_batch(batch, threads=1, record_trajectory=True)
-    two = simulation.run_batch(batch, threads=2, record_trajectory=True)
-    for name, column in one.columns.items():
-        np.testing.assert_array_equal(column, two.columns[name], err_msg=name)
-    for name, column in one.trajectory.items():
-        np.testing.assert_array_equal(column, two.trajectory[name], err_msg=name)
+    whole = simulation.run_batch(batch, record_trajectory=True)
+    parts = [
+        simulation.run_batch(batch.take(np.arange(a, b)), record_trajectory=True)
+        for a, b in ((0, 17), (17, 40), (40, 60))
+    ]
+    joined = pi.BatchResult.concat(parts)
+    for name, column in whole.columns.items():
+        np.testing.assert_array_equal(column, joined.columns[name], err_msg=name)
+    for name, column in whole.trajectory.items():
+        np.testing.assert_array_equal(column, joined.trajectory[name], err_msg=name)
+    assert joined.trajectory_of(45).time.size == whole.trajectory_of(45).time.size

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import os
 from abc import ABC, abstractmethod
-from concurrent.futures import ThreadPoolExecutor
 from typing import ClassVar
 
 import numpy as np
@@ -33,43 +31,14 @@ class Integrator(ABC):
 
     name: ClassVar[str]
     version: ClassVar[str] = "1"
-    #: Below this many scenes per thread, one thread does the whole batch.
-    MIN_SCENES_PER_THREAD: ClassVar[int] = 500
 
     def run(
-        self,
-        model: ImpactModel,
-        batch: SceneBatch,
-        *,
-        record_trajectory: bool = False,
-        threads: int | None = None,
+        self, model: ImpactModel, batch: SceneBatch, *, record_trajectory: bool = False
     ) -> BatchResult:
-        """Integrate every scene of ``batch`` to its outcome.
-
-        Large batches are split into contiguous chunks integrated in ``threads`` threads
-        (default: one per CPU); numpy releases the GIL in its loops. A scene's result does
-        not depend on the other scenes of its batch (a tested property of every built-in
-        integrator), so the split changes no result.
-        """
-        bound = model.bind(batch) if batch.size else batch
-        threads = (os.cpu_count() or 1) if threads is None else max(1, threads)
-        chunks = min(threads, batch.size // self.MIN_SCENES_PER_THREAD) or 1
-        if chunks == 1:
-            return self._run_chunk(model, bound, record_trajectory)
-        edges = np.linspace(0, batch.size, chunks + 1).astype(int)
-        parts = [
-            bound.take(np.arange(lo, hi)) for lo, hi in zip(edges[:-1], edges[1:], strict=True)
-        ]
-        with ThreadPoolExecutor(max_workers=chunks) as pool:
-            results = list(
-                pool.map(lambda part: self._run_chunk(model, part, record_trajectory), parts)
-            )
-        return BatchResult.concat(results)
-
-    def _run_chunk(self, model: ImpactModel, bound: SceneBatch, record: bool) -> BatchResult:
-        recorder = ResultRecorder(bound.size, record, model.failure.state_names)
-        if bound.size:
-            self._integrate(model, bound, recorder)
+        """Integrate every scene of ``batch`` to its outcome."""
+        recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
+        if batch.size:
+            self._integrate(model, model.bind(batch), recorder)
         return recorder.result()
 
     @abstractmethod

@@ -53,18 +53,11 @@ class Simulation:
         return cls(model, registry.create("integrator", integrator, **(integrator_settings or {})))
 
     def run_batch(
-        self,
-        scenes: SceneBatch | Iterable[Scene],
-        *,
-        record_trajectory: bool = False,
-        threads: int | None = None,
+        self, scenes: SceneBatch | Iterable[Scene], *, record_trajectory: bool = False
     ) -> BatchResult:
-        """Results of many scenes, as arrays in the order given (``threads``: see
-        :meth:`Integrator.run`; default one per CPU)."""
+        """Results of many scenes, as arrays in the order given."""
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
-        return self.integrator.run(
-            self.model, batch, record_trajectory=record_trajectory, threads=threads
-        )
+        return self.integrator.run(self.model, batch, record_trajectory=record_trajectory)
 
     def run(self, scene: Scene, *, record_trajectory: bool = False) -> Result:
         """The result of one scene."""
