@@ -24,6 +24,12 @@ KINEMATIC_STATE = 4
 #: Rows of :meth:`ImpactModel.event_margins`. Each margin crosses zero upward at its event.
 ONSET, CONTACT_LOST, PERFORATED, AT_REST, TURNED_BACK = range(5)
 EVENT_NAMES = ("failure onset", "contact lost", "perforated", "at rest", "turned back")
+#: The events that end an impact, and the outcome each one means.
+EVENT_OUTCOMES = {
+    CONTACT_LOST: Outcome.RICOCHET,
+    PERFORATED: Outcome.PERFORATION,
+    AT_REST: Outcome.EMBEDMENT,
+}
 
 
 @attrs.frozen

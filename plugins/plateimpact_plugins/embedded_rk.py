@@ -8,14 +8,12 @@ import attrs
 import numpy as np
 
 from plateimpact import (
-    AT_REST,
-    CONTACT_LOST,
+    EVENT_OUTCOMES,
     KINEMATIC_STATE,
     LATERAL,
     OBLIQUITY,
     ONSET,
     PENETRATION,
-    PERFORATED,
     SPEED,
     TURNED_BACK,
     ImpactModel,
@@ -27,10 +25,11 @@ from plateimpact import (
     SceneBatch,
 )
 
+from ._settings import check_max_steps, check_rtol
+
 #: Where, inside an accepted step, event functions are sampled (fractions of the step).
 #: Sampling between the ends catches a margin that crosses and re-crosses in one step.
 EVENT_SAMPLES = np.linspace(0.0, 1.0, 5)
-BISECTIONS = 52  # halvings of the bracketing sub-step for the deepest point
 MAX_ROOT_ITERATIONS = 16  # Illinois converges superlinearly; more only chases rounding
 ROOT_TOLERANCE = 1e-13  # event time to this fraction of the step
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -38,12 +37,6 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 #: force is still ~0, cannot leap across the contact.
 MAX_STEP = 0.5
 FIRST_STEP = 1e-2
-
-TERMINAL = {
-    CONTACT_LOST: Outcome.RICOCHET,
-    PERFORATED: Outcome.PERFORATION,
-    AT_REST: Outcome.EMBEDMENT,
-}
 
 
 def _combine(weights: np.ndarray, stages: np.ndarray) -> np.ndarray:
@@ -56,21 +49,11 @@ def _combine(weights: np.ndarray, stages: np.ndarray) -> np.ndarray:
     return total
 
 
-def _check_rtol(instance: object, attribute: attrs.Attribute, value: float) -> None:
-    if not (isinstance(value, int | float) and 1e-14 <= value <= 1e-2):
-        raise ParameterError("rtol", f"rtol must be in [1e-14, 1e-2], got {value!r}")
-
-
 def _check_fixed_step(instance: object, attribute: attrs.Attribute, value: float | None) -> None:
     if value is not None and not (isinstance(value, int | float) and 0.0 < value <= MAX_STEP):
         raise ParameterError(
             "fixed_step", f"fixed_step must be in (0, {MAX_STEP}] of Rs/Vs or None, got {value!r}"
         )
-
-
-def _check_max_steps(instance: object, attribute: attrs.Attribute, value: int) -> None:
-    if not (isinstance(value, int) and value > 0):
-        raise ParameterError("max_steps", f"max_steps must be an integer > 0, got {value!r}")
 
 
 @attrs.frozen
@@ -101,8 +84,8 @@ class EmbeddedRungeKutta(Integrator):
     P: ClassVar[np.ndarray]
     error_order: ClassVar[int]
 
-    rtol: float = attrs.field(default=1e-10, validator=_check_rtol)
-    max_steps: int = attrs.field(default=200_000, validator=_check_max_steps)
+    rtol: float = attrs.field(default=1e-10, validator=check_rtol)
+    max_steps: int = attrs.field(default=200_000, validator=check_max_steps)
     fixed_step: float | None = attrs.field(default=None, validator=_check_fixed_step)
 
     def settings(self) -> dict[str, object]:
@@ -112,20 +95,20 @@ class EmbeddedRungeKutta(Integrator):
         self, y: np.ndarray, h: np.ndarray, stages: np.ndarray, sigma: np.ndarray
     ) -> np.ndarray:
         """State at fractions ``sigma`` (shape (n,) or (n, m)) of the step: (d, n[, m])."""
-        if sigma.ndim == 2:
-            return np.stack(
-                [self._dense(y, h, stages, sigma[:, j]) for j in range(sigma.shape[1])], axis=-1
-            )
-        # Stage weights b_j(σ) = Σ_q P[j, q] σ^(q+1), summed stage by stage, element-wise.
-        total = np.zeros_like(y)
+        extra = (np.newaxis,) * (sigma.ndim - 1)
+        # Stage weights b_j(σ) = Σ_q P[j, q] σ^(q+1) by Horner, then Σ_j b_j k_j stage by
+        # stage: element-wise, in a fixed order, whatever the batch.
+        total = None
         for j in range(stages.shape[0]):
-            if not self.P[j].any():
+            row = self.P[j]
+            if not row.any():
                 continue
-            weight = np.zeros_like(sigma)
-            for q in range(self.P.shape[1] - 1, -1, -1):
-                weight = (weight + self.P[j, q]) * sigma
-            total += weight * stages[j]
-        return y + h * total
+            weight = row[-1] * sigma
+            for coefficient in row[-2::-1]:
+                weight = (weight + coefficient) * sigma
+            term = weight * stages[j][(...,) + extra]
+            total = term if total is None else total + term
+        return y[(...,) + extra] + h[(slice(None),) + extra] * total
 
     def _integrate(self, model: ImpactModel, batch: SceneBatch, recorder: ResultRecorder) -> None:
         n = batch.size
@@ -195,9 +178,15 @@ class EmbeddedRungeKutta(Integrator):
                     continue
                 rows = np.flatnonzero(has)
                 first = np.argmax(crossing[kind, rows], axis=1)
+                rows_failed, rows_held, rows_batch = (
+                    failed[idx][rows],
+                    held[idx][rows],
+                    sub.take(rows),
+                )
                 located = self._locate(
-                    model,
-                    kind,
+                    lambda state, kind=kind, f=rows_failed, h=rows_held, b=rows_batch: (
+                        model.event_margin(kind, state, f, h, b)
+                    ),
                     y0[:, rows],
                     h0[rows],
                     k[:, :, rows],
@@ -205,9 +194,6 @@ class EmbeddedRungeKutta(Integrator):
                     EVENT_SAMPLES[first + 1],
                     margins[kind, rows, first],
                     margins[kind, rows, first + 1],
-                    failed[idx][rows],
-                    held[idx][rows],
-                    sub.take(rows),
                 )
                 earlier = located < event_sigma[rows]
                 event_sigma[rows[earlier]] = located[earlier]
@@ -229,13 +215,19 @@ class EmbeddedRungeKutta(Integrator):
             if turning.any():
                 rows = np.flatnonzero(turning.any(axis=1))
                 first = np.argmax(turning[rows], axis=1)
-                crest_sigma, crest = self._bisect_obliquity(
-                    y0[:, rows],
-                    h0[rows],
-                    k[:, :, rows],
-                    EVENT_SAMPLES[first],
-                    EVENT_SAMPLES[first + 1],
+                lo, hi = EVENT_SAMPLES[first], EVENT_SAMPLES[first + 1]
+                rows_k, rows_y, rows_h = k[:, :, rows], y0[:, rows], h0[rows]
+                crest_sigma = self._locate(
+                    lambda state: state[OBLIQUITY] - 0.5 * np.pi,
+                    rows_y,
+                    rows_h,
+                    rows_k,
+                    lo,
+                    hi,
+                    samples[OBLIQUITY, rows, first] - 0.5 * np.pi,
+                    samples[OBLIQUITY, rows, first + 1] - 0.5 * np.pi,
                 )
+                crest = self._dense(rows_y, rows_h, rows_k, crest_sigma)
                 peak[rows] = np.maximum(peak[rows], crest[PENETRATION])
                 if recorder.record_trajectory:  # the deepest point belongs to the path
                     recorder.sample(
@@ -273,7 +265,7 @@ class EmbeddedRungeKutta(Integrator):
             status = np.zeros(y.shape[1], dtype=np.int8)
             events = idx[hit]
             kinds = event_kind[hit]
-            for kind, outcome in TERMINAL.items():
+            for kind, outcome in EVENT_OUTCOMES.items():
                 status[events[kinds == kind]] = outcome
             onset = events[kinds == ONSET]
             if onset.size:
@@ -321,12 +313,13 @@ class EmbeddedRungeKutta(Integrator):
             f"steps (first: scene {int(scene[0])}); raise max_steps or rtol"
         )
 
-    def _locate(self, model, kind, y0, h0, k, lo, hi, f_lo, f_hi, failed, held, batch):
-        """σ in (lo, hi] where event ``kind`` first has margin >= 0.
+    def _locate(self, margin, y0, h0, k, lo, hi, f_lo, f_hi):
+        """σ in (lo, hi] where ``margin(state)`` first reaches >= 0 on the dense output;
+        f_lo < 0 <= f_hi are its values at lo and hi.
 
-        Illinois (modified regula falsi) on the dense output, bisection where a margin is
-        not finite. Each row stops once its bracket is below ROOT_TOLERANCE of the step,
-        so a scene's event time never depends on the other scenes of its batch.
+        Illinois (modified regula falsi), bisection where a margin is not finite. Each row
+        stops once its bracket is below ROOT_TOLERANCE of the step, so a scene's result
+        never depends on the other scenes of its batch.
         """
         lo, hi, f_lo, f_hi = lo.copy(), hi.copy(), f_lo.copy(), f_hi.copy()
         side = np.zeros(lo.size)
@@ -338,7 +331,7 @@ class EmbeddedRungeKutta(Integrator):
             with np.errstate(invalid="ignore", divide="ignore"):
                 secant = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
             x = np.where(usable & (secant > lo) & (secant < hi), secant, 0.5 * (lo + hi))
-            f = model.event_margin(kind, self._dense(y0, h0, k, x), failed, held, batch)
+            f = margin(self._dense(y0, h0, k, x))
             after = (f >= 0.0) & open_
             before = ~(f >= 0.0) & open_
             f_lo = np.where(after & (side > 0), 0.5 * f_lo, f_lo)  # Illinois: an end kept
@@ -347,13 +340,3 @@ class EmbeddedRungeKutta(Integrator):
             lo, f_lo = np.where(before, x, lo), np.where(before, f, f_lo)
             side = np.where(after, 1.0, np.where(before, -1.0, side))
         return hi
-
-    def _bisect_obliquity(self, y0, h0, k, lo, hi) -> np.ndarray:
-        """State where θ crosses 90° upward between σ = lo and hi: the deepest point."""
-        lo, hi = lo.astype(float).copy(), hi.astype(float).copy()
-        for _ in range(BISECTIONS):
-            mid = 0.5 * (lo + hi)
-            after = self._dense(y0, h0, k, mid)[OBLIQUITY] >= 0.5 * np.pi
-            hi = np.where(after, mid, hi)
-            lo = np.where(after, lo, mid)
-        return hi, self._dense(y0, h0, k, hi)

@@ -11,6 +11,7 @@ from scipy.integrate import solve_ivp
 from plateimpact import (
     AT_REST,
     CONTACT_LOST,
+    EVENT_OUTCOMES,
     KINEMATIC_STATE,
     LATERAL,
     OBLIQUITY,
@@ -28,6 +29,8 @@ from plateimpact import (
     SceneBatch,
 )
 
+from ._settings import check_rtol
+
 METHODS = ("DOP853", "RK45", "RK23", "LSODA", "Radau", "BDF")
 #: A phase that has not ended after this many Rs/Vs is an error, not an outcome.
 LONGEST_PHASE = 1e4
@@ -36,11 +39,6 @@ LONGEST_PHASE = 1e4
 def _check_method(instance: object, attribute: attrs.Attribute, value: str) -> None:
     if value not in METHODS:
         raise ParameterError("method", f"method must be one of {', '.join(METHODS)}, got {value!r}")
-
-
-def _check_rtol(instance: object, attribute: attrs.Attribute, value: float) -> None:
-    if not (isinstance(value, int | float) and 1e-14 <= value <= 1e-2):
-        raise ParameterError("rtol", f"rtol must be in [1e-14, 1e-2], got {value!r}")
 
 
 @final
@@ -66,7 +64,7 @@ class ScipyIVP(Integrator):
     name = "solve_ivp"
 
     method: str = attrs.field(default="DOP853", validator=_check_method)
-    rtol: float = attrs.field(default=1e-10, validator=_check_rtol)
+    rtol: float = attrs.field(default=1e-10, validator=check_rtol)
 
     def settings(self) -> dict[str, object]:
         return {"method": self.method, "rtol": self.rtol}
@@ -163,11 +161,7 @@ class ScipyIVP(Integrator):
                 held[0] = True
                 y[OBLIQUITY] = ImpactModel.MAX_OBLIQUITY
                 continue
-            outcome = {
-                CONTACT_LOST: Outcome.RICOCHET,
-                PERFORATED: Outcome.PERFORATION,
-                AT_REST: Outcome.EMBEDMENT,
-            }[kind]
+            outcome = EVENT_OUTCOMES[kind]
             exit_speed = 0.0 if outcome == Outcome.EMBEDMENT else y[SPEED]
             recorder.finish(
                 scene,

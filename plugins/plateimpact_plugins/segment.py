@@ -17,6 +17,8 @@ from plateimpact import (
     SceneBatch,
 )
 
+from ._settings import check_max_steps
+
 #: Default step, as a fraction of Rs/Vs (the time to travel one radius at impact speed).
 DEFAULT_STEP = 1e-3
 #: The finest step the tests and docs use.
@@ -26,11 +28,6 @@ FINEST_STEP = 1e-5
 def _check_step(instance: object, attribute: attrs.Attribute, value: float) -> None:
     if not (isinstance(value, int | float) and 0.0 < value <= 0.1):
         raise ParameterError("step", f"step must be in (0, 0.1] of Rs/Vs, got {value!r}")
-
-
-def _check_max_steps(instance: object, attribute: attrs.Attribute, value: int) -> None:
-    if not (isinstance(value, int) and value > 0):
-        raise ParameterError("max_steps", f"max_steps must be an integer > 0, got {value!r}")
 
 
 @final
@@ -63,7 +60,7 @@ class Segment(Integrator):
     name = "segment"
 
     step: float = attrs.field(default=DEFAULT_STEP, validator=_check_step)
-    max_steps: int = attrs.field(default=20_000_000, validator=_check_max_steps)
+    max_steps: int = attrs.field(default=20_000_000, validator=check_max_steps)
 
     def settings(self) -> dict[str, object]:
         return {"step": self.step, "max_steps": self.max_steps}
