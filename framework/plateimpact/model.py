@@ -187,8 +187,7 @@ class ImpactModel:
         if kind == CONTACT_LOST:
             return contact_lost_margin(pen, obl, batch.radius)
         if kind == PERFORATED:
-            margin = self.perforation_margin(pen, obl, failed, batch)
-            return np.where(obl < 0.5 * np.pi, margin, -np.inf)
+            return self._inward_perforation_margin(pen, obl, failed, batch)
         if kind == AT_REST:
             return batch.rest_speed - y[SPEED]
         if kind == TURNED_BACK:
@@ -228,11 +227,17 @@ class ImpactModel:
         status[at_rest] = Outcome.EMBEDMENT
         lost = contact_lost_margin(penetration, obliquity, batch.radius) >= 0.0
         status[lost] = Outcome.RICOCHET
-        perforated = (obliquity < 0.5 * np.pi) & (
-            self.perforation_margin(penetration, obliquity, failed, batch) >= 0.0
-        )
+        perforated = self._inward_perforation_margin(penetration, obliquity, failed, batch) >= 0.0
         status[perforated] = Outcome.PERFORATION
         return status
+
+    def _inward_perforation_margin(
+        self, penetration: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: SceneBatch
+    ) -> np.ndarray:
+        """The perforation margin where it counts: only while the sphere moves inward
+        (θ < 90°); −inf elsewhere and on intact plates."""
+        margin = self.perforation_margin(penetration, obliquity, failed, batch)
+        return np.where(obliquity < 0.5 * np.pi, margin, -np.inf)
 
     def describe(self) -> dict[str, object]:
         """Plug-in names, versions and settings, for output and archives."""
