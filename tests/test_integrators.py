@@ -120,21 +120,25 @@ def test_events_are_located_on_their_surfaces(integrator, scenes):
 
 def test_rest_direction_converges_with_the_tolerance():
     # A shallow embedment keeps turning as V → 0 (dθ/d ln V = −tan ψ), which amplifies
-    # errors; the rest rule still makes its final direction converge, ~10x per decade.
+    # errors; the rest rule still makes its final direction converge, ~10x per decade
+    # of rtol. Between neighbouring tolerances the error can stall (step patterns cancel
+    # by luck), so the rate is a least-squares slope over six decades.
     scene = pi.Scene(SPHERE, PLATE, 474.0, 9.5 * deg)
     reference = (
-        pi.Simulation.from_names(integrator="solve_ivp", integrator_settings={"rtol": 1e-12})
+        pi.Simulation.from_names(integrator="solve_ivp", integrator_settings={"rtol": 1e-13})
         .run(scene)
         .exit_obliquity
     )
+    tolerances = np.logspace(-6, -12, 7)
     errors = [
         abs(
             pi.Simulation.from_names(integrator_settings={"rtol": r}).run(scene).exit_obliquity
             - reference
         )
-        for r in (1e-6, 1e-8, 1e-10)
+        for r in tolerances
     ]
-    assert errors[1] < errors[0] / 30 and errors[2] < errors[1] / 30, errors
+    slope = np.polyfit(np.log10(tolerances), np.log10(errors), 1)[0]
+    assert slope > 0.7, (slope, errors)
     default = pi.Simulation.from_names().run(scene).exit_obliquity
     assert np.degrees(abs(default - reference)) < 1e-4
 

@@ -123,6 +123,67 @@ def test_failed_plate_never_pushes_the_sphere_forward(sphere):
     assert drag.min() >= 0.0
 
 
+@pytest.mark.parametrize("failure", ["plugging", "hinge"])
+def test_a_path_across_the_normal_is_the_mirror_image(sphere, failure):
+    # θ < 0 (a step that overshoots the normal) is the same contact seen in a mirror:
+    # equal drag, opposite lift; the failure model only ever sees |θ|.
+    model = pi.Simulation.from_names(failure=failure).model
+    n = 400
+    batch = pi.SceneBatch.from_scenes(
+        [pi.Scene(sphere, presets.plate("2024-T3/3.18"), 600.0, 0.3)] * n
+    )
+    bound = model.bind(batch)
+    rng = np.random.default_rng(7)
+    pen = rng.uniform(0.0, 2.5, n) * sphere.radius
+    obl = rng.uniform(1e-6, np.pi, n)
+    speed = rng.uniform(10.0, 1500.0, n)
+    failed = rng.random(n) < 0.5
+    state = model.new_failure_state(n)
+    model.start_failure(failed, pen, obl, speed, state, bound)
+    drag, lift = model.forces(pen, obl, speed, failed, state, bound)
+    mirror_drag, mirror_lift = model.forces(pen, -obl, speed, failed, state, bound)
+    np.testing.assert_array_equal(mirror_drag, drag)
+    np.testing.assert_array_equal(mirror_lift, -lift)
+    held = np.zeros(n, bool)
+    y = np.vstack([pen, np.zeros(n), obl, speed, state])
+    mirrored = y.copy()
+    mirrored[pi.OBLIQUITY] *= -1.0
+    rates, mirror_rates = (
+        model.rates(y, failed, held, bound),
+        model.rates(mirrored, failed, held, bound),
+    )
+    np.testing.assert_array_equal(mirror_rates[pi.OBLIQUITY], -rates[pi.OBLIQUITY])
+    np.testing.assert_array_equal(mirror_rates[pi.LATERAL], -rates[pi.LATERAL])
+    for row in (pi.PENETRATION, pi.SPEED, *range(pi.KINEMATIC_STATE, y.shape[0])):
+        np.testing.assert_array_equal(mirror_rates[row], rates[row])
+
+
+def test_a_process_pool_gives_the_serial_results_bit_for_bit(sphere):
+    from concurrent.futures import ProcessPoolExecutor
+
+    rng = np.random.default_rng(3)
+    scenes = [
+        pi.Scene(sphere, presets.plate(name), speed, np.radians(ob))
+        for name, speed, ob in zip(
+            rng.choice(list(presets.PLATES), 40),
+            rng.uniform(80.0, 1500.0, 40),
+            rng.uniform(0.0, 70.0, 40),
+            strict=True,
+        )
+    ]
+    simulation = pi.Simulation.from_names()
+    serial = simulation.run_batch(scenes, record_trajectory=True)
+    with ProcessPoolExecutor(2) as pool:
+        spread = simulation.run_batch(scenes, record_trajectory=True, executor=pool, chunk_size=7)
+    for name, column in serial.columns.items():
+        np.testing.assert_array_equal(spread.columns[name], column, err_msg=name)
+    for name, column in serial.trajectory.items():
+        np.testing.assert_array_equal(spread.trajectory[name], column, err_msg=name)
+    with pytest.raises(pi.ParameterError, match="chunk_size"):
+        with ProcessPoolExecutor(1) as pool:
+            simulation.run_batch(scenes, executor=pool, chunk_size=0)
+
+
 @pytest.mark.parametrize("integrator", ["segment", "dopri5"])
 def test_scene_result_does_not_depend_on_its_batch(sphere, integrator):
     target = pi.Scene(sphere, presets.plate("2024-T3/3.18"), 640.0, np.radians(60.0))

@@ -119,6 +119,8 @@ class SceneBatch:
         )
 
     def __getattr__(self, name: str) -> np.ndarray:
+        if name.startswith("_"):  # e.g. _columns itself while unpickling: not a column
+            raise AttributeError(name)
         try:
             return self._columns[name]
         except KeyError:

@@ -78,11 +78,16 @@ def force_inclination(
 
 
 def _limit_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
-    """numerator/denominator for denominator >= 0, with the limit at denominator = 0:
-    ±inf by the sign of the numerator, and 0 for 0/0 (the limit θ → 0 at P = Rs)."""
-    safe = denominator > 0.0
-    limit = np.where(numerator > 0.0, np.inf, np.where(numerator < 0.0, -np.inf, 0.0))
-    return np.divide(numerator, denominator, out=limit, where=safe)
+    """numerator/denominator clipped to [−1, 1], for denominator >= 0, with the limit at
+    denominator = 0: ±1 by the sign of the numerator, and 0 for 0/0 (the limit θ → 0 at
+    P = Rs)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = numerator / denominator
+    np.clip(ratio, -1.0, 1.0, out=ratio)
+    undefined = np.isnan(ratio)  # 0/0 only: a zero denominator otherwise gives ±inf
+    if undefined.any():
+        ratio[undefined] = 0.0
+    return ratio
 
 
 def contact_geometry(
@@ -109,8 +114,8 @@ def contact_geometry(
     re_squared = embedment_radius_squared(penetration, radius)
     sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
     # eq 4, (Rs − P)/(Re tan θ) written with sin and cos so that θ = 0 is a limit.
-    ratio_e = np.clip(_limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t), -1.0, 1.0)
-    ratio_s = np.clip(_limit_ratio(centre_height, radius * sin_t), -1.0, 1.0)  # eq 5
+    ratio_e = _limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t)
+    ratio_s = _limit_ratio(centre_height, radius * sin_t)  # eq 5
     # Γ − sin Γ for Γe = 2π − 2 arccos r and Γs = 2 arccos r, with sin(2 arccos r) written
     # as 2 r √(1 − r²): the same values without two more sine evaluations.
     chord_e = 2.0 * ratio_e * np.sqrt(1.0 - ratio_e * ratio_e)

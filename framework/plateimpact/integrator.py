@@ -113,11 +113,13 @@ class ResultRecorder:
         contact_time: np.ndarray,
         max_penetration: np.ndarray,
     ) -> None:
-        """Record the outcome of the finished ``scene`` s."""
+        """Record the outcome of the finished ``scene`` s. The exit obliquity is the angle
+        from the plate normal, >= 0 (a path that ends just across the normal, θ < 0, is
+        the mirror image of one that does not)."""
         c = self.columns
         c["outcome"][scene] = outcome
         c["exit_speed"][scene] = exit_speed
-        c["exit_obliquity"][scene] = exit_obliquity
+        c["exit_obliquity"][scene] = np.abs(exit_obliquity)
         c["contact_time"][scene] = contact_time
         c["max_penetration"][scene] = max_penetration
 

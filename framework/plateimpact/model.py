@@ -84,7 +84,24 @@ class ImpactModel:
         """Net drag and lift [N] on every scene (eqs 1, 15, 21–24).
 
         The failure model is consulted only for the scenes whose plate has failed.
+        θ < 0 is the mirror image of |θ| (a path that has swung across the plate normal,
+        which an explicit step near normal incidence can overshoot): the same drag, the
+        lift reversed. The plug-ins only ever see θ >= 0 (docs/model.md, "mirror").
         """
+        side = np.where(obliquity < 0.0, -1.0, 1.0)
+        obliquity = np.abs(obliquity)
+        drag, lift = self._forces(penetration, obliquity, speed, failed, failure_state, batch)
+        return drag, side * lift
+
+    def _forces(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        failed: np.ndarray,
+        failure_state: np.ndarray,
+        batch: SceneBatch,
+    ) -> tuple[np.ndarray, np.ndarray]:
         drag, lift = contact_force(self.resistance, penetration, obliquity, speed, batch)
         if failed.all():  # no subset to take: every scene has failed
             extra_drag, extra_lift = self.failure.force_change(
@@ -160,8 +177,10 @@ class ImpactModel:
         dy[LATERAL] = spd * np.sin(obl)
         dy[OBLIQUITY] = obliquity_rate
         dy[SPEED] = -drag / batch.mass
+        # The failure model sees the mirror image for θ < 0: |θ| and d|θ|/dt.
+        side = np.where(obl < 0.0, -1.0, 1.0)
         dy[KINEMATIC_STATE:] = self.failure_state_rates(
-            pen, obl, spd, obliquity_rate, failed, failure_state, batch
+            pen, side * obl, spd, side * obliquity_rate, failed, failure_state, batch
         )
         return dy
 
@@ -181,7 +200,7 @@ class ImpactModel:
         self, kind: int, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
     ) -> np.ndarray:
         """One row of :meth:`event_margins`."""
-        pen, obl = y[PENETRATION], y[OBLIQUITY]
+        pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
         if kind == ONSET:
             return np.where(failed, -np.inf, pen - batch.onset_penetration)
         if kind == CONTACT_LOST:
@@ -206,7 +225,7 @@ class ImpactModel:
         if failed.any():
             index = np.flatnonzero(failed)
             margin[index] = self.failure.perforation_margin(
-                penetration[index], obliquity[index], batch.take(index)
+                penetration[index], np.abs(obliquity[index]), batch.take(index)
             )
         return margin
 
@@ -224,6 +243,7 @@ class ImpactModel:
         ricochet (contact lost), which takes precedence over embedment (rest).
         """
         status = np.zeros(penetration.shape, dtype=np.int8)
+        obliquity = np.abs(obliquity)  # θ < 0: the mirror image
         status[at_rest] = Outcome.EMBEDMENT
         lost = contact_lost_margin(penetration, obliquity, batch.radius) >= 0.0
         status[lost] = Outcome.RICOCHET
