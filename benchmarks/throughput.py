@@ -1,6 +1,8 @@
 """Wall time of a 10,000-scene sweep with the default integrator, and what each skip saves.
 
-  * the sweep: minimum of 3 runs after a warm-up;
+  * the sweep: minimum of 3 runs after a warm-up, in this process;
+  * the same sweep spread over a 2-process pool (one chunk per core): warm, and including
+    the pool's start;
   * trajectories: the same sweep recording them (they are off unless asked for);
   * failure terms: one force evaluation on 10,000 states of which a fifth have failed,
     computing the failure terms only for those (what the model does) and for every scene;
@@ -12,7 +14,9 @@ Run:  python benchmarks/throughput.py [--scenes 10000]
 from __future__ import annotations
 
 import argparse
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 from scenes import benchmark_batch
@@ -46,6 +50,25 @@ def main() -> None:
         f"sweep of {batch.size} scenes: {sweep:.2f} s wall "
         f"({sweep / batch.size * 1e6:.0f} us per scene; ricochet/embedment/perforation "
         f"{'/'.join(map(str, counts))})"
+    )
+
+    workers = os.cpu_count() or 1
+    chunk = -(-batch.size // workers)
+    start = time.perf_counter()
+    with ProcessPoolExecutor(workers) as pool:
+        spread = simulation.run_batch(batch, executor=pool, chunk_size=chunk)
+        cold = time.perf_counter() - start
+        warm = best_of(lambda: simulation.run_batch(batch, executor=pool, chunk_size=chunk))
+    assert np.array_equal(spread.exit_speed, result.exit_speed)
+    print(
+        f"the same sweep on a {workers}-process pool: {warm:.2f} s warm, {cold:.2f} s "
+        f"including the pool's start (results bit-identical)"
+    )
+    per_scene = result.stats["force_evaluations"] / batch.size
+    steps = (result.stats["accepted_steps"] + result.stats["rejected_steps"]) / batch.size
+    print(
+        f"per scene: {per_scene:.0f} force evaluations, {steps:.0f} steps "
+        f"({result.stats['rejected_steps'] / batch.size:.0f} rejected)"
     )
 
     recorded = best_of(lambda: simulation.run_batch(batch, record_trajectory=True), repeats=1)

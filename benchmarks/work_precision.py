@@ -27,7 +27,7 @@ from plateimpact import plotting
 RESULTS = Path(__file__).resolve().parent / "results"
 CONFIGS = (
     [("segment", {"step": s}) for s in (1e-2, 3e-3, 1e-3, 3e-4)]
-    + [("dopri5", {"rtol": r}) for r in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)]
+    + [("dopri5", {"rtol": r}) for r in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 3e-10, 1e-10, 1e-11)]
     + [("solve_ivp", {"method": "DOP853", "rtol": r}) for r in (1e-6, 1e-8, 1e-10)]
     + [("solve_ivp", {"method": "RK45", "rtol": r}) for r in (1e-6, 1e-8)]
     + [("solve_ivp", {"method": "LSODA", "rtol": r}) for r in (1e-6, 1e-8)]

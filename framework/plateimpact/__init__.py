@@ -9,9 +9,11 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version
 
 from . import geometry, presets, units
+from .archive import Archive
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .errors import (
+    ArchiveError,
     IntegrationError,
     ParameterError,
     PlateImpactError,
@@ -41,6 +43,7 @@ from .resistance import ResistanceLaw, contact_force
 from .results import BatchResult, Outcome, Result, Trajectory
 from .scene import Scene
 from .simulation import Simulation, run
+from .study import Comparison, Study, StudyResults, Variant
 
 try:
     __version__ = version("plateimpact")
@@ -60,7 +63,10 @@ __all__ = [
     "PERFORATED",
     "SPEED",
     "TURNED_BACK",
+    "Archive",
+    "ArchiveError",
     "BatchResult",
+    "Comparison",
     "FailureModel",
     "ImpactModel",
     "IntegrationError",
@@ -76,9 +82,12 @@ __all__ = [
     "Scene",
     "SceneBatch",
     "Simulation",
+    "Study",
+    "StudyResults",
     "Sphere",
     "Trajectory",
     "UnknownNameError",
+    "Variant",
     "contact_force",
     "contact_geometry",
     "contact_lost_margin",

@@ -19,10 +19,11 @@ import attrs
 import numpy as np
 
 from . import presets
+from .archive import Archive
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .errors import ParameterError, PlateImpactError
-from .results import Outcome
+from .results import BatchResult, Outcome
 from .scene import Scene
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 from .units import deg, g, mm
@@ -136,6 +137,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", metavar="FILE", help="write CSV here (default: standard output)")
     _add_body_options(p)
     _add_model_options(p)
+
+    p = sub.add_parser("reproduce", help="run the report's figure families into one archive")
+    p.add_argument("--out", default="report", help="output directory, created (default: report)")
+
+    p = sub.add_parser("show", help="list an archive's runs, their metadata and a summary")
+    p.add_argument("archive", help="HDF5 archive")
+
+    p = sub.add_parser("compare", help="compare two runs of an archive scene by scene")
+    p.add_argument("archive", help="HDF5 archive")
+    p.add_argument("run_a", help="run name (STUDY/RUN, or RUN when unique)")
+    p.add_argument("run_b", help="run name (STUDY/RUN, or RUN when unique)")
+    p.add_argument("--png", metavar="FILE", help="overlay plot of the two runs")
+
+    p = sub.add_parser(
+        "plot", help="exit speed and obliquity against impact speed, from an archive"
+    )
+    p.add_argument("archive", help="HDF5 archive")
+    p.add_argument("--run", required=True, action="append", help="run name (repeat to overlay)")
+    p.add_argument("--out", required=True, metavar="FILE.png", help="where to draw")
     return parser
 
 
@@ -398,6 +418,97 @@ COMMANDS = {
     "crater": _cmd_crater,
     "sweep": _cmd_sweep,
 }
+
+
+def _cmd_reproduce(args: argparse.Namespace) -> None:
+    from pathlib import Path  # noqa: PLC0415
+
+    try:
+        from plateimpact_studies.reproduce import reproduce  # noqa: PLC0415
+    except ImportError:
+        raise UsageError(
+            "the report studies (package plateimpact_studies) are not installed"
+        ) from None
+    out = Path(args.out)
+    if not out.parent.resolve().is_dir():
+        raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
+    archive, figures = reproduce(out)
+    print(f"archive: {archive}")
+    for figure in figures:
+        print(f"figure:  {figure}")
+
+
+def _run_results(archive: Archive, run: str) -> tuple[str, BatchResult]:
+    name = archive.resolve(run)
+    return name, archive.results(name)
+
+
+def _cmd_show(args: argparse.Namespace) -> None:
+    archive = Archive(args.archive)
+    for name in archive.runs():
+        meta = archive.metadata(name)
+        result = archive.results(name)
+        variant = meta["variant"]
+        counts = np.bincount(result.outcome, minlength=4)[1:]
+        print(f"{name}")
+        print(
+            f"  model: {variant['resistance']} + {variant['failure']}, "
+            f"integrator {variant['integrator']} {meta['model']['integrator_settings']}"
+        )
+        print(
+            f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
+            f"{counts[2]} perforation; wall {meta['wall_time_s']:.2f} s"
+        )
+        print(
+            f"  run {meta['start_time']} on {meta['host']}, plateimpact "
+            f"{meta['versions'].get('plateimpact')}, commit {meta['git_commit'][:12]}"
+        )
+
+
+def _cmd_compare(args: argparse.Namespace) -> None:
+    from .study import StudyResults  # noqa: PLC0415
+
+    _check_directory(args.png, "--png")
+    archive = Archive(args.archive)
+    name_a, name_b = archive.resolve(args.run_a), archive.resolve(args.run_b)
+    (_, result_a), (_, result_b) = _run_results(archive, name_a), _run_results(archive, name_b)
+    study_a, study_b = name_a.split("/", 1)[0], name_b.split("/", 1)[0]
+    if study_a != study_b:
+        raise UsageError(f"runs {name_a} and {name_b} belong to different studies")
+    study = archive.study(study_a)
+    results = StudyResults(study, {name_a: result_a, name_b: result_b})
+    comparison = results.compare(name_a, name_b)
+    scenes = study.scenes
+    print(f"{name_b} against {name_a}: {len(result_a)} scenes")
+    for i in comparison.changed:
+        print(
+            f"  {study.plate_labels[i]:>14} {np.degrees(scenes.impact_obliquity[i]):5.1f} deg "
+            f"{scenes.impact_speed[i]:7.1f} m/s: {Outcome(comparison.outcome_a[i]).label} -> "
+            f"{Outcome(comparison.outcome_b[i]).label}"
+        )
+    print(json.dumps(comparison.summary(), indent=2))
+    if args.png:
+        from . import plotting  # noqa: PLC0415
+
+        plotting.save(plotting.plot_study(results), args.png)
+
+
+def _cmd_plot(args: argparse.Namespace) -> None:
+    from . import plotting  # noqa: PLC0415
+    from .study import StudyResults  # noqa: PLC0415
+
+    _check_directory(args.out, "--out")
+    archive = Archive(args.archive)
+    runs = dict(_run_results(archive, run) for run in args.run)
+    studies = {name.split("/", 1)[0] for name in runs}
+    if len(studies) != 1:
+        raise UsageError(f"--run: runs of one study only, got {', '.join(sorted(runs))}")
+    results = StudyResults(archive.study(studies.pop()), runs)
+    plotting.save(plotting.plot_study(results), args.out)
+    print(f"figure: {args.out}")
+
+
+COMMANDS.update(reproduce=_cmd_reproduce, show=_cmd_show, compare=_cmd_compare, plot=_cmd_plot)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

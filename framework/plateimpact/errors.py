@@ -32,3 +32,8 @@ class UnknownNameError(PlateImpactError, LookupError):
 
 class IntegrationError(PlateImpactError, RuntimeError):
     """An integrator could not bring every scene of a batch to an outcome."""
+
+
+class ArchiveError(PlateImpactError, OSError):
+    """An archive cannot be written or read: missing directory, not HDF5, a checksum
+    mismatch, another process writing it."""

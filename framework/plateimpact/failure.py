@@ -39,6 +39,8 @@ class FailureModel(ABC):
     version: ClassVar[str] = "1"
     #: Names of the variables this model integrates after failure (default: none).
     state_names: ClassVar[tuple[str, ...]] = ()
+    #: Their units, for archives (e.g. ``("rad",)``).
+    state_units: ClassVar[tuple[str, ...]] = ()
 
     def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
         """Per-scene columns to compute once per batch (default none)."""

@@ -7,6 +7,7 @@ or pay the import time. Functions draw on axes you pass and return them.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -18,6 +19,9 @@ from matplotlib.axes import Axes  # noqa: E402
 
 from .crater import CraterSection  # noqa: E402
 from .results import BatchResult, Outcome, Trajectory  # noqa: E402
+
+if TYPE_CHECKING:
+    from .study import StudyResults
 
 OUTCOME_SHADES = {
     Outcome.RICOCHET: "#dbe9f6",
@@ -105,3 +109,42 @@ def save(fig: plt.Figure, path: str) -> None:
     """Save and close a figure."""
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
+
+
+def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> plt.Figure:
+    """Exit speed and exit obliquity against impact speed for every plate × obliquity of a
+    study: one column per (plate, obliquity), the first run solid with its outcome ranges
+    shaded, further runs dashed on top (the report's comparison layout, Figures 30–31)."""
+    study = results.study
+    runs = list(runs or results.runs)
+    labels = np.array(study.plate_labels)
+    obliquity = np.round(np.degrees(study.scenes.impact_obliquity), 6)
+    panels = [
+        (label, ob)
+        for label in dict.fromkeys(study.plate_labels)
+        for ob in sorted(set(obliquity[labels == label]))
+    ]
+    fig, axes = plt.subplots(
+        2,
+        len(panels),
+        figsize=(3.2 * len(panels), 6),
+        sharex="col",
+        squeeze=False,
+        layout="constrained",
+    )
+    for column, (label, ob) in enumerate(panels):
+        index = np.flatnonzero((labels == label) & (obliquity == ob))
+        index = index[np.argsort(study.scenes.impact_speed[index])]
+        speeds = study.scenes.impact_speed[index]
+        for k, run in enumerate(runs):
+            part = results[run].take(index)
+            style = {"color": f"C{k}", "ls": "-" if k == 0 else "--"}
+            plot_exit_curves(axes[:, column], speeds, part, label=run, shade=k == 0, **style)
+        axes[0, column].set_title(f"{label}, {ob:g}°", fontsize=9)
+        axes[0, column].set_xlabel("")
+        if column:
+            for ax in axes[:, column]:
+                ax.set_ylabel("")
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle(f"{study.name}: ricochet | embedment | perforation ranges shaded ({runs[0]})")
+    return fig

@@ -161,6 +161,19 @@ class BatchResult:
     def __len__(self) -> int:
         return self.columns["outcome"].size
 
+    def take(self, index: np.ndarray) -> BatchResult:
+        """The results of the scenes ``index`` (integer array), trajectories included."""
+        index = np.asarray(index, dtype=int)
+        columns = {k: c[index] for k, c in self.columns.items()}
+        if self.trajectory is None:
+            return BatchResult(columns, stats=dict(self.stats))
+        pieces = [
+            np.arange(self.trajectory_offsets[i], self.trajectory_offsets[i + 1]) for i in index
+        ]
+        samples = np.concatenate(pieces) if pieces else np.zeros(0, dtype=int)
+        trajectory = {k: x[samples] for k, x in self.trajectory.items()}
+        return BatchResult(columns, trajectory, self.trajectory_counts[index], dict(self.stats))
+
     def __getattr__(self, name: str) -> np.ndarray:
         try:
             return self.__dict__["columns"][name]

@@ -61,6 +61,7 @@ class Hinge(PlaneSeparation):
 
     name = "hinge"
     state_names = ("finger_angle",)
+    state_units = ("rad",)
 
     finger_area_scale: float = attrs.field(default=1.0, validator=_non_negative)
     hinge_obliquity: float | None = attrs.field(default=None, validator=_hinge_obliquity)

@@ -109,6 +109,10 @@ class PstarTable:
         """One P* [m] for every impact."""
         return cls.from_rows([(0.0, pstar * 1e3, pstar * 1e3, 0.0, 0.0)])
 
+    def as_setting(self) -> list[list[float]]:
+        """The table as a JSON value (its rows), for study variants and archives."""
+        return [list(row) for row in self.rows()]
+
     def rows(self) -> list[tuple[float, ...]]:
         """The table in user units, as :meth:`from_rows` takes it."""
         return [

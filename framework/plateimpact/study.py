@@ -1,0 +1,320 @@
+"""Studies: a named set of scenes run through one or more model variants."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Mapping, Sequence
+from concurrent.futures import Executor
+from pathlib import Path
+from typing import Any
+
+import attrs
+import numpy as np
+
+from . import presets
+from .batch import SceneBatch
+from .bodies import Plate, Sphere
+from .errors import ParameterError, UnknownNameError
+from .registry import PluginRegistry
+from .results import BatchResult, Outcome
+from .scene import Scene
+from .simulation import (
+    DEFAULT_FAILURE,
+    DEFAULT_INTEGRATOR,
+    DEFAULT_RESISTANCE,
+    Simulation,
+)
+
+#: Scenes per task: hundreds to thousands, so the step loop's fixed cost per iteration
+#: is spread over many scenes while a progress bar still moves.
+DEFAULT_CHUNK_SIZE = 1000
+
+
+def _json_value(value: object) -> object:
+    """Settings as JSON values, so that a variant is archived and read back unchanged."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if hasattr(value, "as_setting"):  # e.g. a PstarTable: its rows
+        return value.as_setting()
+    raise ParameterError("settings", f"setting value {value!r} is not a JSON value")
+
+
+def _settings(value: Mapping[str, Any] | None) -> dict[str, Any]:
+    return json.loads(json.dumps(dict(value or {}), default=_json_value, sort_keys=True))
+
+
+def _check_name(instance: object, attribute: attrs.Attribute, value: str) -> None:
+    if not isinstance(value, str) or not value or "/" in value or value != value.strip():
+        raise ParameterError(
+            attribute.name, f"{attribute.name} must be a non-empty name without '/', got {value!r}"
+        )
+
+
+@attrs.frozen
+class Variant:
+    """One model variant of a study: plug-in names and their settings.
+
+    Settings are held as JSON values (a :class:`PstarTable` becomes its rows), exactly as
+    the archive stores them, so a variant read back from an archive equals this one.
+    """
+
+    name: str = attrs.field(validator=_check_name)
+    resistance: str = DEFAULT_RESISTANCE
+    failure: str = DEFAULT_FAILURE
+    integrator: str = DEFAULT_INTEGRATOR
+    resistance_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
+    failure_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
+    integrator_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
+    rest_speed_fraction: float = 1e-2
+
+    def simulation(self, registry: PluginRegistry | None = None) -> Simulation:
+        """The resolved model and integrator (plug-ins looked up by name once)."""
+        return Simulation.from_names(
+            self.resistance,
+            self.failure,
+            self.integrator,
+            resistance_settings=self.resistance_settings,
+            failure_settings=self.failure_settings,
+            integrator_settings=self.integrator_settings,
+            rest_speed_fraction=self.rest_speed_fraction,
+            registry=registry,
+        )
+
+    def to_json(self) -> str:
+        return json.dumps(attrs.asdict(self), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> Variant:
+        return cls(**json.loads(text))
+
+
+def _variants(value: Iterable[Variant] | Variant) -> tuple[Variant, ...]:
+    variants = (value,) if isinstance(value, Variant) else tuple(value)
+    names = [v.name for v in variants]
+    if not variants or len(set(names)) != len(names):
+        raise ParameterError(
+            "variants", f"variants must be one or more distinct names, got {names}"
+        )
+    return variants
+
+
+def _labels(value: Sequence[str] | np.ndarray) -> tuple[str, ...]:
+    return tuple(str(label) for label in value)
+
+
+@attrs.frozen(eq=False)
+class Study:
+    """A named set of scenes and the model variants to run on them.
+
+    Parameters
+    ----------
+    name : str
+        No '/': it names the study's group in an archive.
+    scenes : SceneBatch
+        The impacts, SI units (build with :meth:`grid` or :meth:`from_scenes`).
+    variants : Variant or sequence of Variant
+        Distinct names; each becomes one run.
+    plate_labels : sequence of str
+        One label per scene (the preset name for preset plates), for tables and plots.
+    description : str
+    """
+
+    name: str = attrs.field(validator=_check_name)
+    scenes: SceneBatch = attrs.field(validator=attrs.validators.instance_of(SceneBatch))
+    variants: tuple[Variant, ...] = attrs.field(converter=_variants)
+    plate_labels: tuple[str, ...] = attrs.field(converter=_labels)
+    description: str = ""
+
+    @plate_labels.validator
+    def _check_labels(self, attribute: attrs.Attribute, value: tuple[str, ...]) -> None:
+        if len(value) != self.scenes.size:
+            raise ParameterError(
+                "plate_labels", f"plate_labels needs one label per scene ({self.scenes.size})"
+            )
+
+    @classmethod
+    def grid(
+        cls,
+        name: str,
+        plates: Sequence[str | Plate],
+        obliquities_deg: Sequence[float],
+        speeds: Sequence[float],
+        variants: Iterable[Variant] | Variant,
+        *,
+        sphere: Sphere = presets.DEFAULT_SPHERE,
+        description: str = "",
+    ) -> Study:
+        """Every plate × obliquity [deg] × speed [m/s]; plates by preset name or Plate."""
+        batches, labels = [], []
+        for plate in plates:
+            label = (
+                plate if isinstance(plate, str) else f"{plate.material}/{plate.thickness * 1e3:g}"
+            )
+            plate = presets.plate(plate) if isinstance(plate, str) else plate
+            batch = SceneBatch.grid(sphere, plate, speeds, np.radians(obliquities_deg))
+            batches.append(batch)
+            labels += [label] * batch.size
+        return cls(name, SceneBatch.concat(batches), variants, labels, description)
+
+    @classmethod
+    def from_scenes(
+        cls,
+        name: str,
+        scenes: Iterable[Scene],
+        variants: Iterable[Variant] | Variant,
+        *,
+        description: str = "",
+    ) -> Study:
+        """An explicit list of scenes (custom plates and spheres)."""
+        scenes = list(scenes)
+        labels = [f"{s.plate.material}/{s.plate.thickness * 1e3:g}" for s in scenes]
+        return cls(name, SceneBatch.from_scenes(scenes), variants, labels, description)
+
+    def variant(self, name: str) -> Variant:
+        for variant in self.variants:
+            if variant.name == name:
+                return variant
+        choices = ", ".join(v.name for v in self.variants)
+        raise UnknownNameError(
+            f"study {self.name!r} has no variant {name!r}; choose from: {choices}"
+        )
+
+    def run(
+        self,
+        *,
+        archive: str | Path | None = None,
+        executor: Executor | None = None,
+        chunk_size: int = DEFAULT_CHUNK_SIZE,
+        record_trajectory: bool = False,
+        progress: bool | None = None,
+        registry: PluginRegistry | None = None,
+    ) -> StudyResults:
+        """Run every variant on every scene.
+
+        Parameters
+        ----------
+        archive : path, optional
+            HDF5 archive to append each run to as soon as it finishes (docs/archive.md).
+        executor : concurrent.futures.Executor, optional
+            Where chunks of ``chunk_size`` scenes run (a process pool, a Dask client's
+            ``get_executor()``); the study stays the single writer of the archive.
+        record_trajectory : bool
+            Keep every scene's path (and let crater sections be computed from it).
+        progress : bool or None
+            Progress bar on stderr; None shows it on a terminal only.
+        """
+        from .archive import Archive, run_metadata  # noqa: PLC0415 (archive imports study)
+        from .progress import progress_bar  # noqa: PLC0415
+
+        if not (isinstance(chunk_size, int) and chunk_size >= 1):
+            raise ParameterError(
+                "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
+            )
+        writer = Archive(archive) if archive is not None else None
+        if writer is not None:
+            writer.check_writable()
+        runs: dict[str, BatchResult] = {}
+        with progress_bar(self.scenes.size * len(self.variants), self.name, progress) as bar:
+            for variant in self.variants:
+                simulation = variant.simulation(registry)
+                metadata = run_metadata(variant, simulation)
+                chunks = [
+                    self.scenes.take(np.arange(lo, min(lo + chunk_size, self.scenes.size)))
+                    for lo in range(0, self.scenes.size, chunk_size)
+                ]
+                parts = []
+                if executor is None:
+                    for chunk in chunks:
+                        parts.append(
+                            simulation.run_batch(chunk, record_trajectory=record_trajectory)
+                        )
+                        bar.update(chunk.size)
+                else:
+                    futures = [
+                        executor.submit(_run_chunk, simulation, chunk, record_trajectory)
+                        for chunk in chunks
+                    ]
+                    for future, chunk in zip(futures, chunks, strict=True):
+                        parts.append(future.result())
+                        bar.update(chunk.size)
+                result = BatchResult.concat(parts)
+                metadata.finish()
+                runs[variant.name] = result
+                if writer is not None:
+                    writer.append_run(self, variant, result, metadata.as_attributes())
+        return StudyResults(self, runs)
+
+
+def _run_chunk(simulation: Simulation, batch: SceneBatch, record_trajectory: bool) -> BatchResult:
+    """One task of :meth:`Study.run`, in an executor's worker."""
+    return simulation.run_batch(batch, record_trajectory=record_trajectory)
+
+
+@attrs.frozen(eq=False)
+class Comparison:
+    """Run B against run A on the same scenes: outcome changes and exit differences.
+
+    ``exit_speed_change`` [m/s] and ``exit_obliquity_change`` [rad] are B − A, NaN where
+    either run ends in embedment (no exit) for the obliquity.
+    """
+
+    run_a: str
+    run_b: str
+    outcome_a: np.ndarray
+    outcome_b: np.ndarray
+    exit_speed_change: np.ndarray
+    exit_obliquity_change: np.ndarray
+
+    @property
+    def changed(self) -> np.ndarray:
+        """Indices of the scenes whose outcome differs."""
+        return np.flatnonzero(self.outcome_a != self.outcome_b)
+
+    def summary(self) -> dict[str, object]:
+        """Counts of each outcome transition and the largest exit differences (user units)."""
+        transitions: dict[str, int] = {}
+        for i in self.changed:
+            key = f"{Outcome(self.outcome_a[i]).label} -> {Outcome(self.outcome_b[i]).label}"
+            transitions[key] = transitions.get(key, 0) + 1
+        both = np.isfinite(self.exit_obliquity_change)
+        return {
+            "scenes": int(self.outcome_a.size),
+            "outcome_changes": int(self.changed.size),
+            "transitions": transitions,
+            "max_abs_exit_speed_change_m_s": float(
+                np.max(np.abs(self.exit_speed_change), initial=0.0)
+            ),
+            "max_abs_exit_obliquity_change_deg": float(
+                np.degrees(np.max(np.abs(self.exit_obliquity_change[both]), initial=0.0))
+            ),
+        }
+
+
+class StudyResults:
+    """The runs of a study, by name: each a :class:`BatchResult` over the study's scenes."""
+
+    def __init__(self, study: Study, runs: Mapping[str, BatchResult]) -> None:
+        self.study = study
+        self.runs = dict(runs)
+
+    def __getitem__(self, name: str) -> BatchResult:
+        try:
+            return self.runs[name]
+        except KeyError:
+            choices = ", ".join(self.runs)
+            raise UnknownNameError(f"no run {name!r}; choose from: {choices}") from None
+
+    def compare(self, run_a: str, run_b: str) -> Comparison:
+        """Per scene: outcome A and B, Δ exit speed and Δ exit obliquity (B − A)."""
+        a, b = self[run_a], self[run_b]
+        flying = (a.outcome != Outcome.EMBEDMENT) & (b.outcome != Outcome.EMBEDMENT)
+        return Comparison(
+            run_a,
+            run_b,
+            a.outcome.copy(),
+            b.outcome.copy(),
+            b.exit_speed - a.exit_speed,
+            np.where(flying, b.exit_obliquity - a.exit_obliquity, np.nan),
+        )

@@ -1,0 +1,30 @@
+"""What every figure-family script does when run: run its study into an archive, plot it."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import plateimpact as pi
+from plateimpact import plotting
+
+#: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
+SPEEDS = [50.0 + 10.0 * k for k in range(146)]
+
+
+def run_and_plot(study: pi.Study, out: Path, archive: Path, progress: bool | None = None) -> Path:
+    """Run ``study`` (appending its runs to ``archive``) and draw ``out/<study>.png``."""
+    results = study.run(archive=archive, progress=progress)
+    figure = plotting.plot_study(results)
+    path = out / f"{study.name}.png"
+    plotting.save(figure, str(path))
+    return path
+
+
+def main(study: pi.Study) -> None:
+    parser = argparse.ArgumentParser(description=study.description)
+    parser.add_argument("--out", default=".", help="directory for the archive and the PNG")
+    args = parser.parse_args()
+    out = Path(args.out)
+    png = run_and_plot(study, out, out / f"{study.name}.h5")
+    print(f"archive: {out / f'{study.name}.h5'}\nfigure:  {png}")

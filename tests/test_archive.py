@@ -1,0 +1,245 @@
+"""Studies and their HDF5 archives: round trip, safety, bad input, comparison, Dask."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import plateimpact as pi
+from plateimpact.cli import main as cli
+
+SPEEDS = np.linspace(150.0, 1200.0, 8)
+
+
+def small_study(name="t318", trajectory_variant=False):
+    variants = [pi.Variant("plugging"), pi.Variant("large-pstar", failure="intact")]
+    return pi.Study.grid(name, ["2024-T3/3.18", "SAE1010/1.47"], [0, 45, 60], SPEEDS, variants)
+
+
+def assert_same(a: pi.BatchResult, b: pi.BatchResult) -> None:
+    for name, column in a.columns.items():
+        np.testing.assert_array_equal(b.columns[name], column, err_msg=name)
+        assert b.columns[name].dtype == column.dtype, name
+    assert (a.trajectory is None) == (b.trajectory is None)
+    if a.trajectory is not None:
+        assert list(a.trajectory) == list(b.trajectory)
+        for name, column in a.trajectory.items():
+            np.testing.assert_array_equal(b.trajectory[name], column, err_msg=name)
+        np.testing.assert_array_equal(b.trajectory_counts, a.trajectory_counts)
+
+
+def test_round_trip_is_bit_for_bit(tmp_path):
+    study = pi.Study.grid(
+        "hinge", ["SAE1010/1.47"], [0, 30], SPEEDS, [pi.Variant("hinge", failure="hinge")]
+    )
+    path = tmp_path / "a.h5"
+    results = study.run(archive=path, record_trajectory=True)
+    archive = pi.Archive(path)
+    assert archive.runs() == ["hinge/hinge"]
+    assert_same(results["hinge"], archive.results("hinge"))
+    back = archive.study()
+    assert back.name == study.name and back.variants == study.variants
+    assert back.plate_labels == study.plate_labels and back.description == study.description
+    for column in pi.batch.BASE_COLUMNS:
+        np.testing.assert_array_equal(getattr(back.scenes, column), getattr(study.scenes, column))
+    loaded = archive.load()
+    assert_same(results["hinge"], loaded["hinge"])
+    meta = archive.metadata("hinge")
+    assert meta["variant"]["failure"] == "hinge" and meta["failure_state_units"] == {
+        "finger_angle": "rad"
+    }
+    assert meta["wall_time_s"] > 0 and meta["versions"]["numpy"] == np.__version__
+
+
+def test_archive_is_self_describing_in_plain_h5py(tmp_path):
+    path = tmp_path / "a.h5"
+    small_study().run(archive=path, record_trajectory=True)
+    datasets = []
+    with h5py.File(path, "r") as f:  # no project code from here on
+        assert f.attrs["format"] == "plateimpact-archive"
+        f.visititems(
+            lambda name, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None
+        )
+        assert datasets
+        for ds in datasets:
+            assert "units" in ds.attrs and "description" in ds.attrs, ds.name
+            assert ds.fletcher32 and ds.chunks is not None, ds.name
+        run = f["t318/runs/plugging"]
+        counts = run["trajectory/count"][()]
+        assert counts.sum() == run["trajectory/time"].shape[0]
+        assert run["results/exit_speed"].attrs["units"] == "m/s"
+
+
+def test_runs_append_without_touching_earlier_ones(tmp_path):
+    path = tmp_path / "a.h5"
+    study = small_study()
+    first = study.run(archive=path)
+    with h5py.File(path, "r") as f:
+        before = f["t318/runs/plugging/results/exit_speed"][()]
+    second = study.run(archive=path)  # the same study again: runs get a suffix
+    archive = pi.Archive(path)
+    assert archive.runs() == [
+        "t318/plugging",
+        "t318/large-pstar",
+        "t318/plugging.2",
+        "t318/large-pstar.2",
+    ]
+    np.testing.assert_array_equal(archive.results("t318/plugging").exit_speed, before)
+    assert_same(first["plugging"], second["plugging"])
+    other = pi.Study.grid("t318", ["2024-T3/1.27"], [0], SPEEDS, [pi.Variant("x")])
+    with pytest.raises(pi.ArchiveError, match="different study"):
+        other.run(archive=path)
+
+
+KILL_SCRIPT = """
+import sys
+import numpy as np
+import plateimpact as pi
+study = pi.Study.grid(
+    "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, {n}),
+    [pi.Variant("fast"),
+     pi.Variant("slow", integrator="segment", integrator_settings={{"step": 1e-4}})],
+)
+study.run(archive=sys.argv[1], chunk_size=50)
+"""
+
+
+def test_killing_the_writer_during_the_second_run_keeps_the_first(tmp_path):
+    path = tmp_path / "a.h5"
+    script = tmp_path / "writer.py"
+    script.write_text(textwrap.dedent(KILL_SCRIPT.format(n=200)))
+    child = subprocess.Popen([sys.executable, str(script), str(path)])
+    archive = pi.Archive(path)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and child.poll() is None:
+            try:
+                if archive.runs():
+                    break
+            except pi.ArchiveError:
+                pass
+            time.sleep(0.05)
+        assert child.poll() is None, "the writer finished before it could be killed"
+        time.sleep(0.5)  # well into the second (slow) run
+    finally:
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+    assert archive.runs() == ["kill/fast"]
+    study = pi.Study.grid(
+        "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 200), pi.Variant("fast")
+    )
+    assert_same(study.run()["fast"], archive.results("kill/fast"))
+
+
+def test_a_live_writer_is_reported_and_a_dead_one_is_not(tmp_path):
+    path = tmp_path / "a.h5"
+    small_study().run(archive=path)
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    lock = path.with_name(path.name + ".lock")
+    try:
+        lock.write_text(f"{sleeper.pid} {os.uname().nodename}\n")
+        with pytest.raises(pi.ArchiveError, match=f"being written by process {sleeper.pid}"):
+            pi.Archive(path).runs()
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    assert len(pi.Archive(path).runs()) == 2  # the lock is stale now: the archive opens
+    small_study().run(archive=path)  # and takes new runs
+    assert not lock.exists()
+
+
+def flip_bytes(path, dataset):
+    with h5py.File(path, "r") as f:
+        offset = f[dataset].id.get_chunk_info(0).byte_offset
+    with open(path, "r+b") as handle:
+        handle.seek(offset + 3)
+        byte = handle.read(1)
+        handle.seek(offset + 3)
+        handle.write(bytes([byte[0] ^ 0xFF]))
+
+
+def test_bad_archives_give_one_line_errors(tmp_path, capsys):
+    path = tmp_path / "a.h5"
+    small_study().run(archive=path)
+    flip_bytes(path, "t318/runs/plugging/results/exit_speed")
+    with pytest.raises(pi.ArchiveError, match="damaged"):
+        pi.Archive(path).results("plugging")
+    not_hdf5 = tmp_path / "notes.h5"
+    not_hdf5.write_text("not an archive\n")
+    cases = [
+        (["show", str(not_hdf5)], "is not an HDF5 file"),
+        (["show", str(tmp_path / "missing" / "a.h5")], "does not exist"),
+        (["compare", str(path), "plugging", "nope"], "no run 'nope'"),
+        (["plot", str(path), "--run", "plugging", "--out", str(tmp_path / "x.png")], "damaged"),
+    ]
+    for argv, message in cases:
+        assert cli(argv) == 2
+        err = capsys.readouterr().err
+        assert message in err and err.count("\n") == 1, err
+    with pytest.raises(pi.ArchiveError, match="does not exist"):
+        small_study().run(archive=tmp_path / "missing" / "a.h5")
+
+
+def test_compare_reports_the_large_pstar_outcome_changes(tmp_path, capsys):
+    path = tmp_path / "a.h5"
+    results = small_study().run(archive=path)
+    comparison = results.compare("plugging", "large-pstar")
+    plugging, intact = results["plugging"].outcome, results["large-pstar"].outcome
+    np.testing.assert_array_equal(comparison.changed, np.flatnonzero(plugging != intact))
+    # A plate that never fails is never perforated, and fast impacts perforate it otherwise.
+    assert not np.any(intact == pi.Outcome.PERFORATION)
+    assert comparison.summary()["transitions"]["perforation -> embedment"] > 0
+    assert cli(["compare", str(path), "plugging", "large-pstar"]) == 0
+    out = capsys.readouterr().out
+    assert f'"outcome_changes": {comparison.changed.size}' in out
+    assert out.count("perforation -> embedment") >= 2  # listed per scene and summarised
+
+
+def test_plot_and_show_from_an_archive(tmp_path, capsys):
+    path = tmp_path / "a.h5"
+    small_study().run(archive=path)
+    png = tmp_path / "p.png"
+    assert (
+        cli(["plot", str(path), "--run", "plugging", "--run", "large-pstar", "--out", str(png)])
+        == 0
+    )
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert cli(["show", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "t318/plugging" in out and "t318/large-pstar" in out and "48 scenes" in out
+
+
+def test_a_local_dask_cluster_gives_the_in_process_results(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    study = small_study()
+    local = study.run()
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        spread = study.run(executor=client.get_executor(), chunk_size=10, archive=tmp_path / "d.h5")
+    for name in local.runs:
+        assert_same(local[name], spread[name])
+        assert_same(local[name], pi.Archive(tmp_path / "d.h5").results(name))
+
+
+def test_reproduce_writes_one_archive_and_a_figure_per_family(tmp_path, capsys):
+    out = tmp_path / "report"
+    assert cli(["reproduce", "--out", str(out)]) == 0
+    archive = pi.Archive(out / "report.h5")
+    assert len(archive.studies()) == 5
+    assert len(archive.runs()) == 7  # two comparison families run two variants each
+    pngs = sorted(out.glob("*.png"))
+    assert len(pngs) == 5 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
+    assert str(out / "report.h5") in capsys.readouterr().out
+    assert cli(["reproduce", "--out", str(tmp_path / "missing" / "report")]) == 2
