@@ -21,7 +21,7 @@ class DormandPrince54(EmbeddedRungeKutta):
     ----------
     rtol : float
         Local error tolerance relative to each component's scale, in [1e-14, 1e-2];
-        default 1e-10 (exit speed within 1e-6 of the impact speed and exit obliquity within
+        default 3e-10 (exit speed within 1e-6 of the impact speed and exit obliquity within
         1e-4° of the reference on the benchmark set: docs/integrators.md).
     max_steps : int
     fixed_step : float or None
