@@ -133,10 +133,6 @@ class RunMetadata:
         }
 
 
-def run_metadata(variant: Variant, simulation: Simulation) -> RunMetadata:
-    return RunMetadata(variant, simulation)
-
-
 def _pid_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)

@@ -90,24 +90,12 @@ class ImpactModel:
         """
         side = np.where(obliquity < 0.0, -1.0, 1.0)
         obliquity = np.abs(obliquity)
-        drag, lift = self._forces(penetration, obliquity, speed, failed, failure_state, batch)
-        return drag, side * lift
-
-    def _forces(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        failed: np.ndarray,
-        failure_state: np.ndarray,
-        batch: SceneBatch,
-    ) -> tuple[np.ndarray, np.ndarray]:
         drag, lift = contact_force(self.resistance, penetration, obliquity, speed, batch)
         if failed.all():  # no subset to take: every scene has failed
             extra_drag, extra_lift = self.failure.force_change(
                 penetration, obliquity, speed, failure_state, batch, self.resistance
             )
-            return drag + extra_drag, lift + extra_lift
+            return drag + extra_drag, side * (lift + extra_lift)
         if failed.any():
             index = np.flatnonzero(failed)
             extra_drag, extra_lift = self.failure.force_change(
@@ -120,7 +108,7 @@ class ImpactModel:
             )
             drag[index] += extra_drag
             lift[index] += extra_lift
-        return drag, lift
+        return drag, side * lift
 
     def start_failure(
         self,

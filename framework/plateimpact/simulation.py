@@ -76,16 +76,13 @@ class Simulation:
         calls): use processes.
         """
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
-        if not (isinstance(chunk_size, int | np.integer) and chunk_size >= 1):
-            raise ParameterError(
-                "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
-            )
+        check_chunk_size(chunk_size)
         if executor is None or batch.size <= chunk_size:
             return self.integrator.run(self.model, batch, record_trajectory=record_trajectory)
         bounds = range(0, batch.size, chunk_size)
         futures = [
             executor.submit(
-                _run_chunk,
+                run_chunk,
                 self,
                 batch.take(np.arange(lo, min(lo + chunk_size, batch.size))),
                 record_trajectory,
@@ -108,8 +105,16 @@ class Simulation:
         }
 
 
-def _run_chunk(simulation: Simulation, batch: SceneBatch, record_trajectory: bool) -> BatchResult:
-    """One chunk of :meth:`Simulation.run_batch` in an executor's worker."""
+def check_chunk_size(chunk_size: object) -> None:
+    """Scenes per task must be a positive integer."""
+    if not (isinstance(chunk_size, int | np.integer) and chunk_size >= 1):
+        raise ParameterError(
+            "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
+        )
+
+
+def run_chunk(simulation: Simulation, batch: SceneBatch, record_trajectory: bool) -> BatchResult:
+    """One chunk of a batch, in an executor's worker (picklable: a module function)."""
     return simulation.integrator.run(simulation.model, batch, record_trajectory=record_trajectory)
 
 

@@ -15,6 +15,7 @@ from . import presets
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .errors import ParameterError, UnknownNameError
+from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult, Outcome
 from .scene import Scene
@@ -23,6 +24,8 @@ from .simulation import (
     DEFAULT_INTEGRATOR,
     DEFAULT_RESISTANCE,
     Simulation,
+    check_chunk_size,
+    run_chunk,
 )
 
 #: Scenes per task: hundreds to thousands, so the step loop's fixed cost per iteration
@@ -100,6 +103,11 @@ def _variants(value: Iterable[Variant] | Variant) -> tuple[Variant, ...]:
     return variants
 
 
+def _plate_label(plate: Plate) -> str:
+    """'MATERIAL/THICKNESS_MM', as preset names are spelled."""
+    return f"{plate.material}/{plate.thickness * 1e3:g}"
+
+
 def _labels(value: Sequence[str] | np.ndarray) -> tuple[str, ...]:
     return tuple(str(label) for label in value)
 
@@ -149,9 +157,7 @@ class Study:
         """Every plate × obliquity [deg] × speed [m/s]; plates by preset name or Plate."""
         batches, labels = [], []
         for plate in plates:
-            label = (
-                plate if isinstance(plate, str) else f"{plate.material}/{plate.thickness * 1e3:g}"
-            )
+            label = plate if isinstance(plate, str) else _plate_label(plate)
             plate = presets.plate(plate) if isinstance(plate, str) else plate
             batch = SceneBatch.grid(sphere, plate, speeds, np.radians(obliquities_deg))
             batches.append(batch)
@@ -169,7 +175,7 @@ class Study:
     ) -> Study:
         """An explicit list of scenes (custom plates and spheres)."""
         scenes = list(scenes)
-        labels = [f"{s.plate.material}/{s.plate.thickness * 1e3:g}" for s in scenes]
+        labels = [_plate_label(s.plate) for s in scenes]
         return cls(name, SceneBatch.from_scenes(scenes), variants, labels, description)
 
     def variant(self, name: str) -> Variant:
@@ -205,13 +211,9 @@ class Study:
         progress : bool or None
             Progress bar on stderr; None shows it on a terminal only.
         """
-        from .archive import Archive, run_metadata  # noqa: PLC0415 (archive imports study)
-        from .progress import progress_bar  # noqa: PLC0415
+        from .archive import Archive, RunMetadata  # noqa: PLC0415 (archive imports study)
 
-        if not (isinstance(chunk_size, int) and chunk_size >= 1):
-            raise ParameterError(
-                "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
-            )
+        check_chunk_size(chunk_size)
         writer = Archive(archive) if archive is not None else None
         if writer is not None:
             writer.check_writable()
@@ -219,7 +221,7 @@ class Study:
         with progress_bar(self.scenes.size * len(self.variants), self.name, progress) as bar:
             for variant in self.variants:
                 simulation = variant.simulation(registry)
-                metadata = run_metadata(variant, simulation)
+                metadata = RunMetadata(variant, simulation)
                 chunks = [
                     self.scenes.take(np.arange(lo, min(lo + chunk_size, self.scenes.size)))
                     for lo in range(0, self.scenes.size, chunk_size)
@@ -227,13 +229,11 @@ class Study:
                 parts = []
                 if executor is None:
                     for chunk in chunks:
-                        parts.append(
-                            simulation.run_batch(chunk, record_trajectory=record_trajectory)
-                        )
+                        parts.append(run_chunk(simulation, chunk, record_trajectory))
                         bar.update(chunk.size)
                 else:
                     futures = [
-                        executor.submit(_run_chunk, simulation, chunk, record_trajectory)
+                        executor.submit(run_chunk, simulation, chunk, record_trajectory)
                         for chunk in chunks
                     ]
                     for future, chunk in zip(futures, chunks, strict=True):
@@ -245,11 +245,6 @@ class Study:
                 if writer is not None:
                     writer.append_run(self, variant, result, metadata.as_attributes())
         return StudyResults(self, runs)
-
-
-def _run_chunk(simulation: Simulation, batch: SceneBatch, record_trajectory: bool) -> BatchResult:
-    """One task of :meth:`Study.run`, in an executor's worker."""
-    return simulation.run_batch(batch, record_trajectory=record_trajectory)
 
 
 @attrs.frozen(eq=False)

@@ -165,7 +165,7 @@ class EmbeddedRungeKutta(Integrator):
             # other step. Measured: 745 → 640 force evaluations per scene at rtol 1e-10.
             factor = np.where(np.isfinite(factor), factor, MIN_FACTOR)
             factor = np.where(just_rejected | ~ok, np.minimum(factor, 1.0), factor)
-            just_rejected = np.where(ok, False, True)
+            just_rejected = ~ok
             accepted = int(np.count_nonzero(ok))
             recorder.stats["accepted_steps"] += accepted
             recorder.stats["rejected_steps"] += ok.size - accepted
