@@ -12,19 +12,25 @@ from plateimpact import plotting
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]
 
 
-def run_and_plot(study: pi.Study, out: Path, archive: Path, progress: bool | None = None) -> Path:
-    """Run ``study`` (appending its runs to ``archive``) and draw ``out/<study>.png``."""
-    results = study.run(archive=archive, progress=progress)
-    figure = plotting.plot_study(results)
+def run_and_plot(
+    study: pi.Study, out: Path, archive: Path, progress: bool | None = None, craters: bool = False
+) -> Path:
+    """Run ``study`` (appending its runs to ``archive``) and draw ``out/<study>.png``: exit
+    curves, or with ``craters`` the crater sections (the runs then keep paths and craters)."""
+    results = study.run(archive=archive, progress=progress, craters=craters)
+    if craters:
+        figure = plotting.plot_study_paths(results, kind="crater")
+    else:
+        figure = plotting.plot_study(results)
     path = out / f"{study.name}.png"
     plotting.save(figure, str(path))
     return path
 
 
-def main(study: pi.Study) -> None:
+def main(study: pi.Study, craters: bool = False) -> None:
     parser = argparse.ArgumentParser(description=study.description)
     parser.add_argument("--out", default=".", help="directory for the archive and the PNG")
     args = parser.parse_args()
     out = Path(args.out)
-    png = run_and_plot(study, out, out / f"{study.name}.h5")
+    png = run_and_plot(study, out, out / f"{study.name}.h5", craters=craters)
     print(f"archive: {out / f'{study.name}.h5'}\nfigure:  {png}")

@@ -64,7 +64,7 @@ def figure_35(out: Path) -> Path:
     fig, axes = plotting.plt.subplots(2, 1, figsize=(8, 7), layout="constrained")
     for ax, speed in zip(axes, (263.0, 737.0), strict=True):
         result = simulation.run(pi.Scene(SPHERE, plate, speed, 60 * deg), record_trajectory=True)
-        section = crater_section(result.trajectory, SPHERE.radius)
+        section = crater_section(result.trajectory, SPHERE.radius, thickness=plate.thickness)
         plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=SPHERE.radius)
         ax.set_title(
             f"6061-T6, 9.53 mm, 60°, {speed / 1e3:.3f} km/s: {result.outcome.label}, "

@@ -15,6 +15,7 @@ try:
         fig18_24_2024t3_6_35mm,
         fig25_31_2024t3_3_18mm,
         fig32_34_2024t3_1_27mm,
+        fig35_37_craters_60deg,
         fig38_44_sae1010_1_47mm,
     )
     from ._family import run_and_plot
@@ -23,6 +24,7 @@ except ImportError:  # run as a script
     import fig18_24_2024t3_6_35mm
     import fig25_31_2024t3_3_18mm
     import fig32_34_2024t3_1_27mm
+    import fig35_37_craters_60deg
     import fig38_44_sae1010_1_47mm
     from _family import run_and_plot
 
@@ -42,6 +44,8 @@ def reproduce(out: Path, progress: bool | None = None) -> tuple[Path, list[Path]
     out.mkdir(parents=True, exist_ok=True)
     archive = out / ARCHIVE_NAME
     figures = [run_and_plot(f.study(), out, archive, progress) for f in FAMILIES]
+    craters = fig35_37_craters_60deg.study()
+    figures.append(run_and_plot(craters, out, archive, progress, craters=True))
     return archive, figures
 
 

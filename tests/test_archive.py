@@ -15,6 +15,7 @@ import pytest
 
 import plateimpact as pi
 from plateimpact.cli import main as cli
+from plateimpact.crater import crater_section
 
 SPEEDS = np.linspace(150.0, 1200.0, 8)
 
@@ -34,6 +35,10 @@ def assert_same(a: pi.BatchResult, b: pi.BatchResult) -> None:
         for name, column in a.trajectory.items():
             np.testing.assert_array_equal(b.trajectory[name], column, err_msg=name)
         np.testing.assert_array_equal(b.trajectory_counts, a.trajectory_counts)
+    assert (a.craters is None) == (b.craters is None)
+    if a.craters is not None:
+        for name in ("lateral", "depth", "counts", "impact_point"):
+            np.testing.assert_array_equal(getattr(b.craters, name), getattr(a.craters, name))
 
 
 def test_round_trip_is_bit_for_bit(tmp_path):
@@ -41,7 +46,8 @@ def test_round_trip_is_bit_for_bit(tmp_path):
         "hinge", ["SAE1010/1.47"], [0, 30], SPEEDS, [pi.Variant("hinge", failure="hinge")]
     )
     path = tmp_path / "a.h5"
-    results = study.run(archive=path, record_trajectory=True)
+    results = study.run(archive=path, craters=True)
+    assert results["hinge"].trajectory is not None and results["hinge"].craters is not None
     archive = pi.Archive(path)
     assert archive.runs() == ["hinge/hinge"]
     assert_same(results["hinge"], archive.results("hinge"))
@@ -61,7 +67,7 @@ def test_round_trip_is_bit_for_bit(tmp_path):
 
 def test_archive_is_self_describing_in_plain_h5py(tmp_path):
     path = tmp_path / "a.h5"
-    small_study().run(archive=path, record_trajectory=True)
+    small_study().run(archive=path, craters=True)
     datasets = []
     with h5py.File(path, "r") as f:  # no project code from here on
         assert f.attrs["format"] == "plateimpact-archive"
@@ -75,6 +81,8 @@ def test_archive_is_self_describing_in_plain_h5py(tmp_path):
         run = f["t318/runs/plugging"]
         counts = run["trajectory/count"][()]
         assert counts.sum() == run["trajectory/time"].shape[0]
+        assert run["crater/counts"][()].sum() == run["crater/depth"].shape[0]
+        assert run["crater/depth"].attrs["units"] == "m"
         assert run["results/exit_speed"].attrs["units"] == "m/s"
 
 
@@ -217,6 +225,57 @@ def test_plot_and_show_from_an_archive(tmp_path, capsys):
     assert "t318/plugging" in out and "t318/large-pstar" in out and "48 scenes" in out
 
 
+def test_archived_craters_are_the_sections_of_the_archived_paths(tmp_path):
+    """Each stored section is the one eqs 31-39 give for the stored path, and its deepest
+    point is the sphere's deepest point (max P), or the back surface where it was holed."""
+    path = tmp_path / "a.h5"
+    study = pi.Study.grid(
+        "c", ["6061-T6/9.53", "2024-T3/3.18"], [0, 60], SPEEDS, pi.Variant("default")
+    )
+    in_memory = study.run(archive=path, craters=True, chunk_size=5)["default"]
+    assert_same(study.run(craters=True)["default"], in_memory)  # chunks concatenate exactly
+    result = pi.Archive(path).results("default")
+    assert_same(in_memory, result)
+    scenes = study.scenes
+    holed = 0
+    for i in range(len(result)):
+        section = result.craters.section(i)
+        expected = crater_section(
+            result.trajectory_of(i), scenes.radius[i], thickness=scenes.thickness[i]
+        )
+        np.testing.assert_array_equal(section.depth, expected.depth)
+        np.testing.assert_array_equal(section.lateral, expected.lateral)
+        assert section.impact_point == expected.impact_point
+        deepest = min(result.max_penetration[i], scenes.thickness[i])
+        assert section.max_depth == pytest.approx(deepest, rel=1e-12), i
+        holed += section.max_depth == scenes.thickness[i]
+    assert holed == np.count_nonzero(result.outcome == pi.Outcome.PERFORATION)
+    part = result.take(np.array([3, 0]))
+    np.testing.assert_array_equal(part.craters.section(1).depth, result.craters.section(0).depth)
+
+
+def test_trajectory_and_crater_plots_from_an_archive(tmp_path, capsys):
+    path = tmp_path / "a.h5"
+    study = pi.Study.grid("c", ["2024-T3/3.18"], [0, 60], SPEEDS, pi.Variant("default"))
+    study.run(archive=path, craters=True)
+    for kind in ("crater", "trajectory"):
+        png = tmp_path / f"{kind}.png"
+        args = ["plot", str(path), "--run", "default", "--kind", kind, "--out", str(png)]
+        assert cli([*args, "--speed", "300", "--speed", "900"]) == 0
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert cli(["show", str(path)]) == 0
+    assert "with trajectories and craters" in capsys.readouterr().out
+    bare = tmp_path / "bare.h5"
+    small_study().run(archive=bare)
+    out = str(tmp_path / "x.png")
+    assert cli(["plot", str(bare), "--run", "plugging", "--kind", "crater", "--out", out]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "craters=True" in err and "\n" not in err
+    args = ["plot", str(path), "--run", "default", "--kind", "crater", "--out", out]
+    assert cli([*args, "--speed", "nan"]) == 2
+    assert "--speed" in capsys.readouterr().err
+
+
 def test_a_local_dask_cluster_gives_the_in_process_results(tmp_path):
     distributed = pytest.importorskip("distributed")
     study = small_study()
@@ -237,9 +296,10 @@ def test_reproduce_writes_one_archive_and_a_figure_per_family(tmp_path, capsys):
     out = tmp_path / "report"
     assert cli(["reproduce", "--out", str(out)]) == 0
     archive = pi.Archive(out / "report.h5")
-    assert len(archive.studies()) == 5
-    assert len(archive.runs()) == 7  # two comparison families run two variants each
+    assert len(archive.studies()) == 6  # five figure families and the craters of 35-37
+    assert len(archive.runs()) == 8  # two comparison families run two variants each
+    assert archive.results("craters_60deg/default").craters is not None
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 5 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
+    assert len(pngs) == 6 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
     assert str(out / "report.h5") in capsys.readouterr().out
     assert cli(["reproduce", "--out", str(tmp_path / "missing" / "report")]) == 2

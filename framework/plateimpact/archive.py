@@ -26,6 +26,7 @@ import h5py
 import numpy as np
 
 from .batch import BASE_COLUMNS, SceneBatch
+from .crater import CraterSections
 from .errors import ArchiveError, UnknownNameError
 from .results import RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from .simulation import Simulation
@@ -62,6 +63,13 @@ TRAJECTORY_DESCRIPTIONS = {
     "obliquity": "direction theta of the velocity from the plate normal",
     "speed": "speed V",
 }
+#: The crater group: a contiguous ragged array like the trajectories.
+CRATER_DESCRIPTIONS = {
+    "lateral": ("m", "distance along the plate from the crater's entry point (all scenes)"),
+    "depth": ("m", "depth of the crater floor below the front surface (all scenes)"),
+    "counts": ("1", "points per scene's section, in scene order"),
+    "impact_point": ("m", "lateral position of first contact in the section's coordinates"),
+}
 assert set(SCENE_UNITS) == set(BASE_COLUMNS) and set(RESULT_DESCRIPTIONS) == set(RESULT_FIELDS)
 
 
@@ -72,6 +80,15 @@ def _dataset(group: h5py.Group, name: str, data: np.ndarray, units: str, descrip
     ds = group.create_dataset(name, data=data, chunks=chunk, maxshape=(None,), fletcher32=True)
     ds.attrs["units"] = units
     ds.attrs["description"] = description
+
+
+def _write_craters(group: h5py.Group, craters: CraterSections) -> None:
+    group.attrs["layout"] = (
+        "contiguous ragged array (CF): counts gives each scene's points (eqs 31-39)"
+    )
+    for name, (units, description) in CRATER_DESCRIPTIONS.items():
+        _dataset(group, name, getattr(craters, name), units, description)
+    group["counts"].attrs["sample_dimension"] = "lateral"
 
 
 def _git_commit() -> str:
@@ -264,6 +281,8 @@ class Archive:
         results = group.create_group("results")
         for name, units in RESULT_FIELDS.items():
             _dataset(results, name, result.columns[name], units or "1", RESULT_DESCRIPTIONS[name])
+        if result.craters is not None:
+            _write_craters(group.create_group("crater"), result.craters)
         if result.trajectory is None:
             return
         state_units = json.loads(str(attributes.get("failure_state_units", "{}")))
@@ -383,15 +402,20 @@ class Archive:
         base = _run_path(run)
         with self._open() as f:
             columns = {k: self._read(f, f"{base}/results/{k}") for k in RESULT_FIELDS}
+            craters = None
+            if "crater" in f[base]:
+                craters = CraterSections(
+                    **{k: self._read(f, f"{base}/crater/{k}") for k in CRATER_DESCRIPTIONS}
+                )
             if "trajectory" not in f[base]:
-                return BatchResult(columns)
+                return BatchResult(columns, craters=craters)
             names = [k for k in f[f"{base}/trajectory"] if k != "count"]
             order = [k for k in TRAJECTORY_FIELDS if k in names] + [
                 k for k in names if k not in TRAJECTORY_FIELDS
             ]
             trajectory = {k: self._read(f, f"{base}/trajectory/{k}") for k in order}
             counts = self._read(f, f"{base}/trajectory/count")
-            return BatchResult(columns, trajectory, counts)
+            return BatchResult(columns, trajectory, counts, craters=craters)
 
     def load(self, study: str | None = None) -> StudyResults:
         """The study and all its runs."""

@@ -9,6 +9,7 @@ import argparse
 import csv
 import io
 import json
+import math
 import os
 import sys
 import tempfile
@@ -151,11 +152,26 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--png", metavar="FILE", help="overlay plot of the two runs")
 
     p = sub.add_parser(
-        "plot", help="exit speed and obliquity against impact speed, from an archive"
+        "plot", help="exit curves, trajectories or crater sections of runs in an archive"
     )
     p.add_argument("archive", help="HDF5 archive")
     p.add_argument("--run", required=True, action="append", help="run name (repeat to overlay)")
     p.add_argument("--out", required=True, metavar="FILE.png", help="where to draw")
+    p.add_argument(
+        "--kind",
+        choices=("exit", "trajectory", "crater"),
+        default="exit",
+        help="exit speed and obliquity against impact speed (default); the centre's "
+        "trajectories; crater sections (runs recorded with trajectories / craters)",
+    )
+    p.add_argument(
+        "--speed",
+        type=float,
+        action="append",
+        metavar="M_S",
+        help="trajectory/crater: draw the scene nearest this impact speed (repeat; "
+        "default: six spread over the range)",
+    )
     return parser
 
 
@@ -345,7 +361,7 @@ def _cmd_crater(args: argparse.Namespace) -> None:
     sphere, plate, label = _bodies(args)
     scene = Scene(sphere, plate, args.speed, args.obliquity * deg)
     result = _simulation(args).run(scene, record_trajectory=True)
-    section = crater_section(result.trajectory, sphere.radius)
+    section = crater_section(result.trajectory, sphere.radius, thickness=plate.thickness)
     print(
         f"{label}: {args.speed:g} m/s at {args.obliquity:g} deg -> {result.outcome.label}; "
         f"crater {section.length / mm:.4g} mm long, {section.max_depth / mm:.4g} mm deep"
@@ -459,6 +475,13 @@ def _cmd_show(args: argparse.Namespace) -> None:
             f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
             f"{counts[2]} perforation; wall {meta['wall_time_s']:.2f} s"
         )
+        kept = [
+            what
+            for what, data in (("trajectories", result.trajectory), ("craters", result.craters))
+            if data is not None
+        ]
+        if kept:
+            print(f"  with {' and '.join(kept)}")
         print(
             f"  run {meta['start_time']} on {meta['host']}, plateimpact "
             f"{meta['versions'].get('plateimpact')}, commit {meta['git_commit'][:12]}"
@@ -498,13 +521,23 @@ def _cmd_plot(args: argparse.Namespace) -> None:
     from .study import StudyResults  # noqa: PLC0415
 
     _check_directory(args.out, "--out")
+    for speed in args.speed or ():
+        if not (math.isfinite(speed) and speed > 0.0):
+            raise UsageError(f"--speed must be a finite impact speed > 0 m/s, got {speed}")
     archive = Archive(args.archive)
     runs = dict(_run_results(archive, run) for run in args.run)
     studies = {name.split("/", 1)[0] for name in runs}
     if len(studies) != 1:
         raise UsageError(f"--run: runs of one study only, got {', '.join(sorted(runs))}")
     results = StudyResults(archive.study(studies.pop()), runs)
-    plotting.save(plotting.plot_study(results), args.out)
+    if args.kind == "exit":
+        figure = plotting.plot_study(results)
+    else:
+        try:
+            figure = plotting.plot_study_paths(results, kind=args.kind, speeds=args.speed)
+        except ValueError as exc:
+            raise UsageError(str(exc)) from None
+    plotting.save(figure, args.out)
     print(f"figure: {args.out}")
 
 

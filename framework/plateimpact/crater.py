@@ -22,7 +22,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from .results import Trajectory
+from .results import BatchResult, Trajectory
 
 #: Grid of lateral positions for the floor [points].
 DEFAULT_RESOLUTION = 1500
@@ -93,12 +93,17 @@ def crater_floor(
 
 
 def crater_section(
-    trajectory: Trajectory, radius: float, *, resolution: int = DEFAULT_RESOLUTION
+    trajectory: Trajectory,
+    radius: float,
+    *,
+    thickness: float = np.inf,
+    resolution: int = DEFAULT_RESOLUTION,
 ) -> CraterSection:
     """The crater section swept by a sphere of ``radius`` [m] along ``trajectory``.
 
-    Works for any trajectory (any integrator, any outcome). Resolution is the number of
-    lateral grid points across the swept width.
+    Works for any trajectory (any integrator, any outcome). With the plate ``thickness``
+    [m], a floor below the back surface is a hole and is drawn at depth T. Resolution is
+    the number of lateral grid points across the swept width.
     """
     centre_lateral = trajectory.lateral
     centre_depth = trajectory.penetration - radius  # X of eq 33: −Rs at first contact
@@ -116,7 +121,7 @@ def crater_section(
     entry = _surface_crossing(grid, floor, first - 1, first) if first > 0 else grid[0]
     exit_ = _surface_crossing(grid, floor, last + 1, last) if last + 1 < grid.size else grid[-1]
     lateral = np.concatenate([[entry], grid[first : last + 1], [exit_]])
-    depth = np.concatenate([[0.0], np.maximum(floor[first : last + 1], 0.0), [0.0]])
+    depth = np.concatenate([[0.0], np.clip(floor[first : last + 1], 0.0, thickness), [0.0]])
     return CraterSection(lateral - entry, depth, float(-entry))
 
 
@@ -126,3 +131,76 @@ def _surface_crossing(grid: np.ndarray, floor: np.ndarray, outside: int, inside:
         return float(grid[inside])
     fraction = floor[inside] / (floor[inside] - floor[outside])
     return float(grid[inside] + fraction * (grid[outside] - grid[inside]))
+
+
+@attrs.frozen(eq=False)
+class CraterSections:
+    """The crater sections of a batch as a contiguous ragged array (CF conventions).
+
+    Scene ``i`` owns ``lateral[offsets[i]:offsets[i + 1]]`` and the same slice of
+    ``depth``, with ``offsets`` the running sum of ``counts``.
+
+    Attributes
+    ----------
+    lateral : ndarray
+        Distance along the plate from each crater's entry point [m], concatenated.
+    depth : ndarray
+        Depth of the floor below the front surface [m], concatenated.
+    counts : ndarray
+        Points per scene [1].
+    impact_point : ndarray
+        Lateral position of each scene's first-contact point [m].
+    """
+
+    lateral: np.ndarray
+    depth: np.ndarray
+    counts: np.ndarray
+    impact_point: np.ndarray
+
+    @classmethod
+    def from_result(
+        cls, result: BatchResult, radius: np.ndarray, thickness: np.ndarray
+    ) -> CraterSections:
+        """Sections of every scene of ``result`` (recorded with its trajectories) for
+        sphere radii ``radius`` [m] and plate thicknesses ``thickness`` [m], per scene."""
+        if result.trajectory is None:
+            raise ValueError("crater sections need trajectories: run with record_trajectory")
+        radius, thickness = np.broadcast_arrays(radius, thickness, np.zeros(len(result)))[:2]
+        sections = [
+            crater_section(result.trajectory_of(i), float(radius[i]), thickness=float(thickness[i]))
+            for i in range(len(result))
+        ]
+        return cls.from_sections(sections)
+
+    @classmethod
+    def from_sections(cls, sections: list[CraterSection]) -> CraterSections:
+        """Pack single sections in order."""
+        return cls(
+            np.concatenate([s.lateral for s in sections]) if sections else np.zeros(0),
+            np.concatenate([s.depth for s in sections]) if sections else np.zeros(0),
+            np.array([s.lateral.size for s in sections], dtype=np.int64),
+            np.array([s.impact_point for s in sections], dtype=float),
+        )
+
+    @classmethod
+    def concat(cls, parts: list[CraterSections]) -> CraterSections:
+        """One ragged array holding ``parts`` in order."""
+        return cls(
+            *(np.concatenate([getattr(p, k) for p in parts]) for k in attrs.fields_dict(cls))
+        )
+
+    @property
+    def offsets(self) -> np.ndarray:
+        return np.concatenate([[0], np.cumsum(self.counts)])
+
+    def __len__(self) -> int:
+        return self.counts.size
+
+    def section(self, i: int) -> CraterSection:
+        """The section of scene ``i``."""
+        lo, hi = self.offsets[i], self.offsets[i + 1]
+        return CraterSection(self.lateral[lo:hi], self.depth[lo:hi], float(self.impact_point[i]))
+
+    def take(self, index: np.ndarray) -> CraterSections:
+        """The sections of scenes ``index`` (integer array), in that order."""
+        return CraterSections.from_sections([self.section(int(i)) for i in index])

@@ -148,3 +148,86 @@ def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> plt.
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(f"{study.name}: ricochet | embedment | perforation ranges shaded ({runs[0]})")
     return fig
+
+
+#: What :func:`plot_study_paths` can draw from a run.
+PATH_KINDS = ("trajectory", "crater")
+
+
+def _panels(results: StudyResults) -> list[tuple[str, float, np.ndarray]]:
+    """(plate label, obliquity [deg], scene indices sorted by impact speed) per panel."""
+    study = results.study
+    labels = np.array(study.plate_labels)
+    obliquity = np.round(np.degrees(study.scenes.impact_obliquity), 6)
+    panels = []
+    for label in dict.fromkeys(study.plate_labels):
+        for ob in sorted(set(obliquity[labels == label])):
+            index = np.flatnonzero((labels == label) & (obliquity == ob))
+            panels.append((label, ob, index[np.argsort(study.scenes.impact_speed[index])]))
+    return panels
+
+
+def _pick(speeds: np.ndarray, wanted: Sequence[float] | None, count: int) -> np.ndarray:
+    """Positions in ``speeds`` (sorted) nearest each wanted speed, or ``count`` spread evenly."""
+    if wanted is None:
+        return np.unique(
+            np.linspace(0, speeds.size - 1, min(count, speeds.size)).round().astype(int)
+        )
+    return np.unique([int(np.argmin(np.abs(speeds - w))) for w in wanted])
+
+
+def plot_study_paths(
+    results: StudyResults,
+    runs: Sequence[str] | None = None,
+    *,
+    kind: str = "crater",
+    speeds: Sequence[float] | None = None,
+    count: int = 6,
+) -> plt.Figure:
+    """Crater sections (eqs 31–39) or the centre's trajectories, one panel per plate ×
+    obliquity of a study, one line per impact speed [m/s] (``speeds``: the scenes nearest
+    these; default ``count`` spread over the range); the first run solid, others dashed.
+
+    Craters need runs made with ``craters=True``, trajectories ``record_trajectory=True``.
+    Depth is drawn downward in mm: craters from the entry point, trajectories from the
+    first-contact point, with the plate's back surface dotted.
+    """
+    if kind not in PATH_KINDS:
+        raise ValueError(f"kind must be one of {', '.join(PATH_KINDS)}, got {kind!r}")
+    study = results.study
+    runs = list(runs or results.runs)
+    for run in runs:
+        if (results[run].craters if kind == "crater" else results[run].trajectory) is None:
+            need = "craters=True" if kind == "crater" else "record_trajectory=True"
+            raise ValueError(f"run {run!r} has no {kind} data: run the study with {need}")
+    panels = _panels(results)
+    fig, axes = plt.subplots(
+        len(panels), 1, figsize=(8, 2.6 * len(panels)), squeeze=False, layout="constrained"
+    )
+    for ax, (label, ob, index) in zip(axes[:, 0], panels, strict=True):
+        chosen = index[_pick(study.scenes.impact_speed[index], speeds, count)]
+        colours = plt.cm.viridis(np.linspace(0.0, 0.9, chosen.size))
+        thickness = study.scenes.thickness[chosen[0]] * 1e3
+        for k, run in enumerate(runs):
+            result = results[run]
+            for colour, i in zip(colours, chosen, strict=True):
+                style = {"color": colour, "ls": "-" if k == 0 else "--", "lw": 1.2}
+                name = f"{study.scenes.impact_speed[i]:g} m/s, {Outcome(result.outcome[i]).label}"
+                if kind == "crater":
+                    section = result.craters.section(i)
+                    ax.plot(section.lateral * 1e3, section.depth * 1e3, label=name, **style)
+                else:
+                    path = result.trajectory_of(i)
+                    centre = (path.penetration - study.scenes.radius[i]) * 1e3
+                    ax.plot(path.lateral * 1e3, centre, label=name, **style)
+        ax.axhline(0.0, color="0.3", lw=0.8)
+        ax.axhline(thickness, color="0.3", lw=0.8, ls=":")
+        ax.set_title(f"{label}, {ob:g}° ({', '.join(runs)})", fontsize=9)
+        ax.set_xlabel("along the plate [mm]")
+        ax.set_ylabel("depth [mm]" if kind == "crater" else "centre depth [mm]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.invert_yaxis()
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    what = "crater sections" if kind == "crater" else "trajectories of the centre"
+    fig.suptitle(f"{study.name}: {what}")
+    return fig

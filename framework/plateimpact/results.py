@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import enum
 import math
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
+
+if TYPE_CHECKING:
+    from .crater import CraterSections
 
 
 class Outcome(enum.IntEnum):
@@ -125,7 +129,8 @@ class BatchResult:
 
     Trajectories, when recorded, are stored as contiguous ragged arrays: every sample of
     every scene concatenated in ``trajectory[field]``, scene ``i`` owning the slice
-    ``trajectory_offsets[i]:trajectory_offsets[i + 1]``.
+    ``trajectory_offsets[i]:trajectory_offsets[i + 1]``. Crater sections, when asked for,
+    are a :class:`~plateimpact.crater.CraterSections` in ``craters``.
     """
 
     def __init__(
@@ -134,6 +139,7 @@ class BatchResult:
         trajectory: dict[str, np.ndarray] | None = None,
         trajectory_counts: np.ndarray | None = None,
         stats: dict[str, float] | None = None,
+        craters: CraterSections | None = None,
     ) -> None:
         missing = set(RESULT_FIELDS) - set(columns)
         if missing:
@@ -142,6 +148,7 @@ class BatchResult:
         self.trajectory = trajectory
         self.trajectory_counts = trajectory_counts
         self.stats = stats or {}
+        self.craters = craters
         if trajectory_counts is not None:
             self.trajectory_offsets = np.concatenate([[0], np.cumsum(trajectory_counts)])
 
@@ -150,13 +157,16 @@ class BatchResult:
         """One result holding ``parts`` in order (e.g. the chunks of a threaded run)."""
         columns = {k: np.concatenate([p.columns[k] for p in parts]) for k in parts[0].columns}
         stats = {k: sum(p.stats.get(k, 0) for p in parts) for k in parts[0].stats}
+        craters = None
+        if parts[0].craters is not None:
+            craters = type(parts[0].craters).concat([p.craters for p in parts])
         if parts[0].trajectory is None:
-            return cls(columns, stats=stats)
+            return cls(columns, stats=stats, craters=craters)
         trajectory = {
             k: np.concatenate([p.trajectory[k] for p in parts]) for k in parts[0].trajectory
         }
         counts = np.concatenate([p.trajectory_counts for p in parts])
-        return cls(columns, trajectory, counts, stats)
+        return cls(columns, trajectory, counts, stats, craters)
 
     def __len__(self) -> int:
         return self.columns["outcome"].size
@@ -165,14 +175,16 @@ class BatchResult:
         """The results of the scenes ``index`` (integer array), trajectories included."""
         index = np.asarray(index, dtype=int)
         columns = {k: c[index] for k, c in self.columns.items()}
+        craters = None if self.craters is None else self.craters.take(index)
         if self.trajectory is None:
-            return BatchResult(columns, stats=dict(self.stats))
+            return BatchResult(columns, stats=dict(self.stats), craters=craters)
         pieces = [
             np.arange(self.trajectory_offsets[i], self.trajectory_offsets[i + 1]) for i in index
         ]
         samples = np.concatenate(pieces) if pieces else np.zeros(0, dtype=int)
         trajectory = {k: x[samples] for k, x in self.trajectory.items()}
-        return BatchResult(columns, trajectory, self.trajectory_counts[index], dict(self.stats))
+        counts = self.trajectory_counts[index]
+        return BatchResult(columns, trajectory, counts, dict(self.stats), craters)
 
     def __getattr__(self, name: str) -> np.ndarray:
         try:

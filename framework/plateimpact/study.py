@@ -194,6 +194,7 @@ class Study:
         executor: Executor | None = None,
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         record_trajectory: bool = False,
+        craters: bool = False,
         progress: bool | None = None,
         registry: PluginRegistry | None = None,
     ) -> StudyResults:
@@ -207,7 +208,10 @@ class Study:
             Where chunks of ``chunk_size`` scenes run (a process pool, a Dask client's
             ``get_executor()``); the study stays the single writer of the archive.
         record_trajectory : bool
-            Keep every scene's path (and let crater sections be computed from it).
+            Keep every scene's path.
+        craters : bool
+            Also compute every scene's crater section (eqs 31–39), which records the
+            paths too; about 2 ms per scene.
         progress : bool or None
             Progress bar on stderr; None shows it on a terminal only.
         """
@@ -229,11 +233,11 @@ class Study:
                 parts = []
                 if executor is None:
                     for chunk in chunks:
-                        parts.append(run_chunk(simulation, chunk, record_trajectory))
+                        parts.append(run_chunk(simulation, chunk, record_trajectory, craters))
                         bar.update(chunk.size)
                 else:
                     futures = [
-                        executor.submit(run_chunk, simulation, chunk, record_trajectory)
+                        executor.submit(run_chunk, simulation, chunk, record_trajectory, craters)
                         for chunk in chunks
                     ]
                     for future, chunk in zip(futures, chunks, strict=True):
