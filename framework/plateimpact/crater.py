@@ -14,7 +14,9 @@ envelope is the two vertical walls. plateimpact therefore computes the floor dir
 at each lateral position y, the deepest point of any circle of radius Rs centred on the
 trajectory. Where the report's curve is the envelope the two agree (tested); elsewhere
 the floor adds the end cap. The section is shifted so that it starts where the floor
-crosses the front surface on the entry side: that point is the origin.
+crosses the front surface on the entry side: that point is the origin. Given the plate
+thickness, a floor below the back surface is a hole and is drawn at depth T (a
+perforation's crater is holed where the sphere went through).
 """
 
 from __future__ import annotations
