@@ -38,6 +38,26 @@ def test_thick_plate_ricochet_obliquity_rises_to_180_and_stays():
     assert ricochet[-1] >= np.pi - 1e-6 and np.all(ricochet <= np.pi)
 
 
+@pytest.mark.parametrize("integrator", ["dopri5", "solve_ivp"])
+def test_obliquity_is_held_at_180_once_within_the_tolerance(sphere, integrator):
+    """θ = π is a stable equilibrium approached exponentially (docs/model.md, "θ = π"):
+    the hold starts once π − θ <= TURN_BACK_TOLERANCE, so a sphere that turns back deep
+    in a thick plate reaches exactly 180° in finite time and keeps it to rest."""
+    scene = pi.Scene(sphere, presets.plate("2024-T3/6.35"), 689.0, np.radians(50.1))
+    result = pi.Simulation.from_names(integrator=integrator).run(scene, record_trajectory=True)
+    assert result.outcome == pi.Outcome.EMBEDMENT and result.exit_obliquity == np.pi
+    obliquity = result.trajectory.obliquity
+    held = np.flatnonzero(obliquity == np.pi)
+    assert held.size and np.all(obliquity[held[0] :] == np.pi)  # held from then on
+    before = obliquity[: held[0]]
+    # The hold starts where π − θ reaches the tolerance (the event, located to rounding),
+    # not where θ would reach π.
+    tolerance = pi.ImpactModel.TURN_BACK_TOLERANCE
+    assert np.pi - before[-1] == pytest.approx(tolerance, rel=1e-6)
+    assert np.all(np.pi - before[:-1] > tolerance)
+    assert np.all(np.diff(before[before > 0.9 * np.pi]) >= 0.0)  # a monotone approach
+
+
 def test_thin_plate_ricochets_after_failure_just_below_embedment():
     # Report, thin-plate ricochet: failure during ricochet gives a narrow band of
     # ricochets at lower exit speed and higher exit obliquity just below the embedment

@@ -52,6 +52,10 @@ class ImpactModel:
 
     #: Obliquity is held here once reached (model-notes §4): straight back out [rad].
     MAX_OBLIQUITY: ClassVar[float] = np.pi
+    #: θ = π is a stable equilibrium that θ approaches exponentially, ever faster as V
+    #: falls, and never reaches: it counts as reached this close [rad] (docs/model.md,
+    #: "θ = π").
+    TURN_BACK_TOLERANCE: ClassVar[float] = 1e-8
 
     def bind(self, batch: SceneBatch) -> SceneBatch:
         """The batch with every per-scene constant the step loop needs, computed once:
@@ -180,7 +184,7 @@ class ImpactModel:
         Each crosses zero upward at its event and is −inf where the event cannot happen:
         failure onset (P − P*, intact plates), contact lost (θ − π/2 − α1), perforation
         (the failure model's margin, failed plates, while θ < π/2), rest (V_rest − V),
-        turned back (θ − π, not yet held).
+        turned back (θ − π + TURN_BACK_TOLERANCE, not yet held).
         """
         return np.stack([self.event_margin(k, y, failed, held, batch) for k in range(5)])
 
@@ -198,7 +202,7 @@ class ImpactModel:
         if kind == AT_REST:
             return batch.rest_speed - y[SPEED]
         if kind == TURNED_BACK:
-            return np.where(held, -np.inf, obl - self.MAX_OBLIQUITY)
+            return np.where(held, -np.inf, obl - (self.MAX_OBLIQUITY - self.TURN_BACK_TOLERANCE))
         raise ValueError(f"no event {kind}")
 
     def perforation_margin(
