@@ -178,15 +178,19 @@ class EmbeddedRungeKutta(Integrator):
             sub = batch.take(idx)
             y0, h0 = y[:, idx], h[idx]
             k = self._dense_coefficients(h0, stages[:, :, idx])
-            sigma = np.broadcast_to(EVENT_SAMPLES, (idx.size, EVENT_SAMPLES.size))
-            samples = self._dense(y0, k, sigma)  # (d, m, s)
-            margins = np.stack(
-                [
-                    model.event_margins(samples[:, :, j], failed[idx], held[idx], sub)
-                    for j in range(EVENT_SAMPLES.size)
-                ],
-                axis=-1,
-            )  # (events, m, s)
+            # The ends are the step's own states; only the interior needs the dense output.
+            sigma = np.broadcast_to(EVENT_SAMPLES[1:-1], (idx.size, EVENT_SAMPLES.size - 2))
+            samples = np.concatenate(
+                [y0[:, :, np.newaxis], self._dense(y0, k, sigma), y_new[:, idx, np.newaxis]],
+                axis=2,
+            )  # (d, m, s)
+            # One call for every sample: each scene's samples side by side, its constants
+            # repeated (margins are element-wise, so the values are those of a call per
+            # sample, at a fifth of the calls).
+            repeat = np.repeat(np.arange(idx.size), EVENT_SAMPLES.size)
+            margins = model.event_margins(
+                samples.reshape(width, -1), failed[idx][repeat], held[idx][repeat], sub.take(repeat)
+            ).reshape(-1, idx.size, EVENT_SAMPLES.size)  # (events, m, s)
             crossing = (margins[:, :, :-1] < 0.0) & (margins[:, :, 1:] >= 0.0)
             event_sigma = np.full(idx.size, np.inf)
             event_kind = np.full(idx.size, -1)
