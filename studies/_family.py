@@ -13,11 +13,17 @@ SPEEDS = [50.0 + 10.0 * k for k in range(146)]
 
 
 def run_and_plot(
-    study: pi.Study, out: Path, archive: Path, progress: bool | None = None, craters: bool = False
+    study: pi.Study,
+    out: Path,
+    archive: Path,
+    progress: bool | None = None,
+    craters: bool = False,
+    resume: bool = False,
 ) -> Path:
-    """Run ``study`` (appending its runs to ``archive``) and draw ``out/<study>.png``: exit
-    curves, or with ``craters`` the crater sections (the runs then keep paths and craters)."""
-    results = study.run(archive=archive, progress=progress, craters=craters)
+    """Run ``study`` (appending its runs to ``archive``; with ``resume``, only those not
+    there yet) and draw ``out/<study>.png``: exit curves, or with ``craters`` the crater
+    sections (the runs then keep paths and craters)."""
+    results = study.run(archive=archive, progress=progress, craters=craters, resume=resume)
     if craters:
         figure = plotting.plot_study_paths(results, kind="crater")
     else:

@@ -38,23 +38,27 @@ FAMILIES = (
 ARCHIVE_NAME = "report.h5"
 
 
-def reproduce(out: Path, progress: bool | None = None) -> tuple[Path, list[Path]]:
+def reproduce(
+    out: Path, progress: bool | None = None, resume: bool = False
+) -> tuple[Path, list[Path]]:
     """Run every family into ``out/report.h5`` and draw its PNGs. An existing archive is
-    appended to (its earlier runs kept; the new ones get a ``.2``, ``.3`` suffix)."""
+    appended to (its earlier runs kept; the new ones get a ``.2``, ``.3`` suffix), or with
+    ``resume`` its finished runs are read back and only the missing ones run."""
     out.mkdir(parents=True, exist_ok=True)
     archive = out / ARCHIVE_NAME
-    figures = [run_and_plot(f.study(), out, archive, progress) for f in FAMILIES]
+    figures = [run_and_plot(f.study(), out, archive, progress, resume=resume) for f in FAMILIES]
     craters = fig35_37_craters_60deg.study()
-    figures.append(run_and_plot(craters, out, archive, progress, craters=True))
+    figures.append(run_and_plot(craters, out, archive, progress, craters=True, resume=resume))
     return archive, figures
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="report", help="output directory (created)")
+    parser.add_argument("--resume", action="store_true", help="run only the missing runs")
     args = parser.parse_args()
     start = time.perf_counter()
-    archive, figures = reproduce(Path(args.out))
+    archive, figures = reproduce(Path(args.out), resume=args.resume)
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")

@@ -147,6 +147,30 @@ def test_killing_the_writer_during_the_second_run_keeps_the_first(tmp_path):
     assert_same(study.run()["fast"], archive.results("kill/fast"))
 
 
+def test_resume_reads_back_finished_runs_and_runs_the_rest(tmp_path):
+    path = tmp_path / "a.h5"
+    fast, coarse = pi.Variant("fast"), pi.Variant("coarse", integrator_settings={"rtol": 1e-6})
+    speeds = np.linspace(150.0, 1200.0, 6)
+    pi.Study.grid("r", ["2024-T3/3.18"], [0, 60], speeds, fast).run(archive=path)
+    written = pi.Archive(path).metadata("r/fast")["end_time"]
+    study = pi.Study.grid("r", ["2024-T3/3.18"], [0, 60], speeds, [fast, coarse])
+    resumed = study.run(archive=path, resume=True)
+    archive = pi.Archive(path)
+    assert archive.runs() == ["r/fast", "r/coarse"]  # fast was not run again
+    assert archive.metadata("r/fast")["end_time"] == written
+    assert_same(resumed["fast"], archive.results("r/fast"))
+    assert_same(resumed["coarse"], study.run()["coarse"])
+    assert study.run(archive=path, resume=True).runs.keys() == {"fast", "coarse"}
+    assert archive.runs() == ["r/fast", "r/coarse"]  # nothing left to do
+    changed = pi.Variant("fast", integrator_settings={"rtol": 1e-7})  # same name, other model
+    pi.Study.grid("r", ["2024-T3/3.18"], [0, 60], speeds, changed).run(archive=path, resume=True)
+    assert archive.runs()[-1] == "r/fast.2"
+    with pytest.raises(pi.ParameterError, match="resume"):
+        study.run(resume=True)
+    with_craters = study.run(archive=path, resume=True, craters=True)  # not kept: run again
+    assert with_craters["coarse"].craters is not None and archive.runs()[-1] == "r/coarse.2"
+
+
 def test_a_live_writer_is_reported_and_a_dead_one_is_not(tmp_path):
     path = tmp_path / "a.h5"
     small_study().run(archive=path)
@@ -302,4 +326,6 @@ def test_reproduce_writes_one_archive_and_a_figure_per_family(tmp_path, capsys):
     pngs = sorted(out.glob("*.png"))
     assert len(pngs) == 6 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
     assert str(out / "report.h5") in capsys.readouterr().out
+    assert cli(["reproduce", "--out", str(out), "--resume"]) == 0  # everything is there
+    assert len(pi.Archive(out / "report.h5").runs()) == 8
     assert cli(["reproduce", "--out", str(tmp_path / "missing" / "report")]) == 2

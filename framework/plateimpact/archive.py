@@ -247,19 +247,41 @@ class Archive:
                 temporary.unlink(missing_ok=True)
         return f"{study.name}/{name}"
 
+    def finished_runs(self, study: Study) -> dict[str, str]:
+        """The runs of ``study`` already in the archive, by variant name: those whose
+        recorded variant (plug-ins and settings) is one of the study's, on the same
+        scenes. Empty when the archive or the study is not there yet."""
+        if not self.path.exists():
+            return {}
+        with self._open() as f:
+            if study.name not in f:
+                return {}
+            self._check_same_scenes(f[study.name], study)
+            runs = f[study.name].get("runs", {})
+            found: dict[str, str] = {}
+            for name in sorted(runs, key=lambda r: _start(runs[r])):
+                recorded = Variant.from_json(str(runs[name].attrs["variant"]))
+                if recorded in study.variants and recorded.name not in found:
+                    found[recorded.name] = f"{study.name}/{name}"
+            return found
+
+    @staticmethod
+    def _check_same_scenes(group: h5py.Group, study: Study) -> None:
+        scenes = group["scenes"]
+        same = set(scenes) >= set(BASE_COLUMNS) and all(
+            np.array_equal(scenes[k][()], getattr(study.scenes, k)) for k in BASE_COLUMNS
+        )
+        if not same:
+            raise ArchiveError(
+                f"the archive already holds a different study named {study.name!r}; "
+                "rename the study"
+            )
+
     @staticmethod
     def _study_group(f: h5py.File, study: Study) -> h5py.Group:
         if study.name in f:
             group = f[study.name]
-            scenes = group["scenes"]
-            same = set(scenes) >= set(BASE_COLUMNS) and all(
-                np.array_equal(scenes[k][()], getattr(study.scenes, k)) for k in BASE_COLUMNS
-            )
-            if not same:
-                raise ArchiveError(
-                    f"the archive already holds a different study named {study.name!r}; "
-                    "rename the study"
-                )
+            Archive._check_same_scenes(group, study)
             return group
         group = f.create_group(study.name)
         group.attrs["description"] = study.description

@@ -141,6 +141,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("reproduce", help="run the report's figure families into one archive")
     p.add_argument("--out", default="report", help="output directory, created (default: report)")
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="keep the runs already in DIR/report.h5 and run only the missing ones "
+        "(default: add every run again, as NAME.2, ...)",
+    )
 
     p = sub.add_parser("show", help="list an archive's runs, their metadata and a summary")
     p.add_argument("archive", help="HDF5 archive")
@@ -448,7 +454,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> None:
     out = Path(args.out)
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
-    archive, figures = reproduce(out)
+    archive, figures = reproduce(out, resume=args.resume)
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")

@@ -195,6 +195,7 @@ class Study:
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         record_trajectory: bool = False,
         craters: bool = False,
+        resume: bool = False,
         progress: bool | None = None,
         registry: PluginRegistry | None = None,
     ) -> StudyResults:
@@ -212,6 +213,11 @@ class Study:
         craters : bool
             Also compute every scene's crater section (eqs 31–39), which records the
             paths too; about 2 ms per scene.
+        resume : bool
+            Finish an interrupted study: a variant whose run is already in ``archive``
+            (same plug-ins and settings, same scenes, with the trajectories or craters
+            asked for) is read back instead of run again. Runs are archived only when
+            finished, so an interrupted run is simply absent.
         progress : bool or None
             Progress bar on stderr; None shows it on a terminal only.
         """
@@ -221,9 +227,21 @@ class Study:
         writer = Archive(archive) if archive is not None else None
         if writer is not None:
             writer.check_writable()
+        if resume and writer is None:
+            raise ParameterError("resume", "resume=True needs the archive to resume from")
+        finished = writer.finished_runs(self) if resume else {}
         runs: dict[str, BatchResult] = {}
         with progress_bar(self.scenes.size * len(self.variants), self.name, progress) as bar:
             for variant in self.variants:
+                if variant.name in finished:
+                    kept = writer.results(finished[variant.name])
+                    lacks = (craters and kept.craters is None) or (
+                        record_trajectory and kept.trajectory is None
+                    )
+                    if not lacks:  # else run it again, keeping what was asked for
+                        runs[variant.name] = kept
+                        bar.update(self.scenes.size)
+                        continue
                 simulation = variant.simulation(registry)
                 metadata = RunMetadata(variant, simulation)
                 chunks = [
