@@ -40,3 +40,26 @@ def sweep(
         [np.radians(obliquity_deg)],
     )
     return simulation.run_batch(batch, record_trajectory=record_trajectory)
+
+
+# Hypothesis profiles: "ci" (the default: few examples, derandomized so CI is
+# reproducible) and "stress" (HYPOTHESIS_PROFILE=stress python -m pytest
+# tests/test_properties.py: many random examples).
+try:
+    import os
+
+    from hypothesis import HealthCheck, settings
+
+    settings.register_profile(
+        "ci",
+        max_examples=12,
+        deadline=None,
+        derandomize=True,
+        suppress_health_check=[HealthCheck.too_slow],
+    )
+    settings.register_profile(
+        "stress", max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+    )
+    settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+except ImportError:  # hypothesis is a test extra
+    pass

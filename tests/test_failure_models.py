@@ -55,6 +55,26 @@ def test_hinge_without_finger_is_plugging_to_tolerance_under_error_control():
     np.testing.assert_allclose(a.exit_obliquity, b.exit_obliquity, atol=np.radians(1e-4))
 
 
+@pytest.mark.parametrize("integrator", ["dopri5", "segment", "solve_ivp"])
+def test_hinge_finger_at_normal_incidence_has_no_lift(integrator):
+    """Found by tests/test_properties.py: eq 19 evaluated as 90° + θ − θ1 − β/2 with
+    θ1 = 90° − α* left a rounding residue (~1e-17 rad) in ψ″ at θ = 0, so the finger
+    lifted a normal impact sideways (lateral 4e-21 m). The full finger (β = 2α*) at θ = 0
+    acts exactly along the path, so the path stays on the normal."""
+    hinge = Hinge()
+    plate = pi.Plate("t", 18.3 * mm, np.exp(18.0), np.exp(4.0), 18.3 * mm, 10 * deg)
+    sphere = pi.Sphere(radius=np.exp(-4.0), mass=0.0282)
+    batch = pi.Simulation.from_names(failure="hinge").model.bind(
+        pi.SceneBatch.from_scenes([pi.Scene(sphere, plate, 403.0, 0.0)])
+    )
+    _, incidence = hinge.finger(np.zeros(1), 2.0 * batch.failure_angle, batch)
+    assert incidence[0] == 0.0
+    simulation = pi.Simulation.from_names(failure="hinge", integrator=integrator)
+    result = simulation.run(pi.Scene(sphere, plate, 403.0, 0.0), record_trajectory=True)
+    assert result.plate_failed and result.exit_obliquity == 0.0
+    assert np.all(result.trajectory.lateral == 0.0)
+
+
 def test_the_finger_changes_the_result():
     batch = grid(STEEL, [45, 60])
     hinge, plugging = run(batch, "hinge"), run(batch, "plugging")

@@ -81,8 +81,8 @@ def _limit_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
     """numerator/denominator clipped to [−1, 1], for denominator >= 0, with the limit at
     denominator = 0: ±1 by the sign of the numerator, and 0 for 0/0 (the limit θ → 0 at
     P = Rs)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = numerator / denominator
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        ratio = numerator / denominator  # ±inf (zero or subnormal denominator) clips to ±1
     np.clip(ratio, -1.0, 1.0, out=ratio)
     undefined = np.isnan(ratio)  # 0/0 only: a zero denominator otherwise gives ±inf
     if undefined.any():

@@ -76,12 +76,15 @@ class Hinge(PlaneSeparation):
         return batch.critical_penetration
 
     def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
-        theta1 = (
-            HALF_PI - batch.failure_angle
-            if self.hinge_obliquity is None
-            else np.full(batch.size, self.hinge_obliquity)
-        )
-        return {**super().prepare(batch), "hinge_obliquity": theta1}
+        if self.hinge_obliquity is None:
+            theta1 = HALF_PI - batch.failure_angle
+            # 90° − θ1 kept as α* itself, not recomputed: with β = 2α* the finger force
+            # then lies exactly along the normal at θ = 0 (no lift from rounding).
+            opening = batch.failure_angle
+        else:
+            theta1 = np.full(batch.size, self.hinge_obliquity)
+            opening = HALF_PI - theta1
+        return {**super().prepare(batch), "hinge_obliquity": theta1, "hinge_opening": opening}
 
     def initial_state(
         self,
@@ -119,7 +122,7 @@ class Hinge(PlaneSeparation):
         theta1 = batch.hinge_obliquity
         incidence = np.where(
             obliquity < theta1,
-            HALF_PI + obliquity - theta1 - half_angle,  # eq 19
+            obliquity + (batch.hinge_opening - half_angle),  # eq 19: 90° + θ − θ1 − β/2
             HALF_PI - half_angle,  # eq 20
         )
         return area, incidence
