@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
+import hashlib
 import json
 import os
 import platform
@@ -27,7 +28,7 @@ import numpy as np
 
 from .batch import BASE_COLUMNS, SceneBatch
 from .crater import CraterSections
-from .errors import ArchiveError, UnknownNameError
+from .errors import ArchiveError, PlateImpactError, UnknownNameError
 from .results import RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from .simulation import Simulation
 from .study import Study, StudyResults, Variant
@@ -80,6 +81,26 @@ def _dataset(group: h5py.Group, name: str, data: np.ndarray, units: str, descrip
     ds = group.create_dataset(name, data=data, chunks=chunk, maxshape=(None,), fletcher32=True)
     ds.attrs["units"] = units
     ds.attrs["description"] = description
+
+
+#: Attribute holding the SHA-256 of a study's or run's other attributes.
+SEAL = "attributes_sha256"
+
+
+def _plain_attributes(group: h5py.Group) -> dict[str, object]:
+    return {k: v.item() if isinstance(v, np.generic) else v for k, v in group.attrs.items()}
+
+
+def _digest(attributes: dict[str, object]) -> str:
+    text = json.dumps({k: attributes[k] for k in sorted(attributes)}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _seal(group: h5py.Group) -> None:
+    """Store the digest of the group's attributes (checked on reading)."""
+    attributes = _plain_attributes(group)
+    attributes.pop(SEAL, None)
+    group.attrs[SEAL] = _digest(attributes)
 
 
 def _write_craters(group: h5py.Group, craters: CraterSections) -> None:
@@ -260,7 +281,7 @@ class Archive:
             runs = f[study.name].get("runs", {})
             found: dict[str, str] = {}
             for name in sorted(runs, key=lambda r: _start(runs[r])):
-                recorded = Variant.from_json(str(runs[name].attrs["variant"]))
+                recorded = Variant.from_json(str(self._check_seal(runs[name])["variant"]))
                 if recorded in study.variants and recorded.name not in found:
                     found[recorded.name] = f"{study.name}/{name}"
             return found
@@ -288,6 +309,7 @@ class Archive:
         group.attrs["variants"] = json.dumps([json.loads(v.to_json()) for v in study.variants])
         labels = sorted(set(study.plate_labels))
         group.attrs["plate_labels"] = json.dumps(labels)
+        _seal(group)
         scenes = group.create_group("scenes")
         scenes.attrs["count"] = study.scenes.size
         for name, (units, description) in SCENE_UNITS.items():
@@ -300,6 +322,7 @@ class Archive:
     def _write_run(group: h5py.Group, result: BatchResult, attributes: dict[str, object]) -> None:
         for key, value in attributes.items():
             group.attrs[key] = value
+        _seal(group)
         results = group.create_group("results")
         for name, units in RESULT_FIELDS.items():
             _dataset(results, name, result.columns[name], units or "1", RESULT_DESCRIPTIONS[name])
@@ -341,9 +364,16 @@ class Archive:
                 f"archive {self.path} cannot be opened: {_first_line(exc)}"
             ) from None
         with f:
-            if f.attrs.get("format") != FORMAT:
-                raise ArchiveError(f"{self.path} is an HDF5 file but not a plateimpact archive")
-            yield f
+            try:
+                if f.attrs.get("format") != FORMAT:
+                    raise ArchiveError(f"{self.path} is an HDF5 file but not a plateimpact archive")
+                yield f
+            except PlateImpactError:
+                raise
+            except (OSError, RuntimeError, KeyError, ValueError, TypeError) as exc:
+                # Damaged structure (not just damaged data, which the checksums catch):
+                # h5py raises any of these from a corrupt header, link or attribute.
+                raise ArchiveError(f"archive {self.path} is damaged: {_first_line(exc)}") from None
 
     def _read(self, f: h5py.File, path: str) -> np.ndarray:
         try:
@@ -385,6 +415,7 @@ class Archive:
         with self._open() as f:
             name = self._study_name(f, name)
             group = f[name]
+            self._check_seal(group)
             columns = {k: self._read(f, f"{name}/scenes/{k}") for k in BASE_COLUMNS}
             labels = json.loads(group.attrs["plate_labels"])
             index = self._read(f, f"{name}/scenes/plate_label")
@@ -409,14 +440,25 @@ class Archive:
     def metadata(self, run: str) -> dict[str, object]:
         run = self.resolve(run)
         with self._open() as f:
-            attrs = dict(f[_run_path(run)].attrs)
+            attrs = self._check_seal(f[_run_path(run)])
         out: dict[str, object] = {}
         for key, value in attrs.items():
-            value = value.item() if isinstance(value, np.generic) else value
             if key in ("variant", "model", "versions", "failure_state_units"):
                 value = json.loads(value)
             out[key] = value
         return out
+
+    def _check_seal(self, group: h5py.Group) -> dict[str, object]:
+        """The group's attributes, after checking them against their digest (attributes
+        have no fletcher32 checksum of their own)."""
+        attrs = _plain_attributes(group)
+        sealed = attrs.pop(SEAL, None)
+        if sealed is not None and sealed != _digest(attrs):
+            raise ArchiveError(
+                f"archive {self.path}: the attributes of {group.name} are damaged "
+                "(their digest does not match)"
+            )
+        return attrs
 
     def results(self, run: str) -> BatchResult:
         """The run's results, bit for bit as they were computed."""

@@ -1,0 +1,152 @@
+"""Bad input fuzzing (issue 7): malformed command lines and damaged archives give a
+one-line error and exit code 2, never a traceback, a hang or a partial write."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import plateimpact as pi
+from plateimpact.cli import main as cli
+
+VALUES = st.sampled_from(
+    [
+        "0", "-1", "1", "3.5", "45", "89.99", "90", "1e400", "-1e400", "nan", "inf", "-0",
+        "1e-300", "abc", "", " ", "2024-T3/3.18", "x/y", "0:10:3", "10:0:3", "1,2,,3",
+        "5:6:0", "7:8:2.5", "0,45", "500,nan", "10:20:5", "dopri5", "segment", "nope",
+        "--", "-", "1e3", "1_000", "0x10",
+    ]
+)  # fmt: skip
+FLAGS = [
+    "--preset", "--speed", "--obliquity", "--speeds", "--obliquities", "--thickness",
+    "--a", "--b", "--pstar", "--alpha", "--radius", "--mass", "--integrator", "--failure",
+    "--resistance", "--json", "--rtol", "--step",
+]  # fmt: skip
+
+
+def run_cli(argv: list[str]) -> tuple[int, str]:
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            code = cli(argv)
+        except SystemExit as exc:  # argparse's own errors
+            code = exc.code
+    return code, err.getvalue()
+
+
+def assert_clean(code: int, err: str) -> None:
+    assert code in (0, 2), (code, err)
+    if code == 2:
+        lines = err.strip().splitlines()
+        assert len(lines) == 1 and "error" in lines[0] and "Traceback" not in err, err
+
+
+@given(
+    command=st.sampled_from(["run", "sweep", "crater"]),
+    options=st.lists(st.tuples(st.sampled_from(FLAGS), VALUES), max_size=8),
+)
+def test_malformed_command_lines_give_one_line_errors(command, options):
+    argv = [command]
+    for flag, value in options:
+        argv += [flag] if flag == "--json" else [flag, value]
+    # Keep accidental valid sweeps small: a fuzz run must not hang on a legitimate job.
+    if command == "sweep" and any(":" in v and not v.endswith(":3") for _, v in options):
+        return
+    assert_clean(*run_cli(argv))
+
+
+class ArchiveBytes(bytes):
+    """A valid archive's bytes, shown by size (hypothesis prints the test's arguments)."""
+
+    def __repr__(self) -> str:
+        return f"<archive of {len(self)} bytes>"
+
+
+@pytest.fixture(scope="module")
+def archive_bytes() -> bytes:
+    with tempfile.TemporaryDirectory() as directory:
+        path = Path(directory) / "a.h5"
+        study = pi.Study.grid(
+            "f", ["2024-T3/3.18"], [0, 60], np.linspace(200, 900, 4), pi.Variant("v")
+        )
+        study.run(archive=path, craters=True)
+        return ArchiveBytes(path.read_bytes())
+
+
+def check_archive(data: bytes) -> None:
+    with tempfile.TemporaryDirectory() as directory:
+        path = Path(directory) / "damaged.h5"
+        path.write_bytes(data)
+        assert_clean(*run_cli(["show", str(path)]))
+        code, err = run_cli(["compare", str(path), "v", "v"])
+        assert_clean(code, err)
+        try:  # the Python API raises ArchiveError (or reads the run back whole)
+            result = pi.Archive(path).results("v")
+            assert len(result) == 8
+        except (pi.ArchiveError, pi.errors.UnknownNameError):
+            pass
+
+
+@given(cut=st.floats(0.0, 1.0))
+def test_truncated_archives_give_one_line_errors(archive_bytes, cut):
+    check_archive(archive_bytes[: int(cut * len(archive_bytes))])
+
+
+@given(flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=8))
+def test_bit_flipped_archives_give_one_line_errors(archive_bytes, flips):
+    data = bytearray(archive_bytes)
+    for where, mask in flips:
+        data[min(int(where * len(data)), len(data) - 1)] ^= mask
+    check_archive(bytes(data))
+
+
+def test_a_refused_run_writes_nothing(tmp_path):
+    """An archive that cannot be extended is left exactly as it was, and no temporary file
+    remains next to it."""
+    path = tmp_path / "a.h5"
+    path.write_bytes(b"not an archive at all")
+    study = pi.Study.grid("f", ["2024-T3/3.18"], [0], [300.0], pi.Variant("v"))
+    with pytest.raises(pi.ArchiveError):
+        study.run(archive=path)
+    assert path.read_bytes() == b"not an archive at all"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]
+    shutil.rmtree(tmp_path / "missing", ignore_errors=True)
+
+
+def test_damaged_archive_structure_gives_archive_error(archive_bytes, tmp_path):
+    """Found by the bit-flip fuzz: a flipped byte in the superblock's addresses made h5py
+    raise RuntimeError ("addr overflow") while listing the runs, which escaped as a
+    traceback. Every h5py error inside an open archive is now an ArchiveError."""
+    data = bytearray(archive_bytes)
+    data[int(6.103515625e-05 * len(data))] ^= 11
+    path = tmp_path / "damaged.h5"
+    path.write_bytes(bytes(data))
+    code, err = run_cli(["show", str(path)])
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "damaged" in err
+    with pytest.raises(pi.ArchiveError):
+        pi.Archive(path).load()
+
+
+def test_damaged_run_attributes_give_archive_error(archive_bytes, tmp_path):
+    """Found by the bit-flip fuzz: attributes carry no fletcher32 checksum, so a flipped
+    byte in a run's JSON metadata escaped as a JSONDecodeError or a KeyError in `show`.
+    Studies and runs now carry a digest of their attributes, checked on reading."""
+    assert archive_bytes.count(b"integrator_version") == 1  # in the run's model attribute
+    path = tmp_path / "damaged.h5"
+    path.write_bytes(archive_bytes.replace(b"integrator_version", b"integrator_versioX"))
+    code, err = run_cli(["show", str(path)])
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "attributes" in err
+    with pytest.raises(pi.ArchiveError, match="digest"):
+        pi.Archive(path).metadata("v")
+    labels = archive_bytes.replace(b'["2024-T3/3.18"]', b'["2024-T3/3.19"]')
+    path.write_bytes(labels)
+    with pytest.raises(pi.ArchiveError, match="digest"):
+        pi.Archive(path).study()
