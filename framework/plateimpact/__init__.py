@@ -14,9 +14,13 @@ from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .errors import (
     ArchiveError,
+    CalibrationError,
+    ConvergenceError,
     IntegrationError,
     ParameterError,
+    PlateFileError,
     PlateImpactError,
+    ShotDataError,
     UnknownNameError,
 )
 from .failure import FailureModel
@@ -42,6 +46,7 @@ from .registry import PluginRegistry, default_registry, load_registry
 from .resistance import ResistanceLaw, contact_force
 from .results import BatchResult, Outcome, Result, Trajectory
 from .scene import Scene
+from .shots import Shots, synthetic_shots
 from .simulation import Simulation, run
 from .study import Comparison, Study, StudyResults, Variant
 
@@ -65,6 +70,8 @@ __all__ = [
     "TURNED_BACK",
     "Archive",
     "ArchiveError",
+    "CalibrationError",
+    "ConvergenceError",
     "BatchResult",
     "Comparison",
     "FailureModel",
@@ -74,6 +81,7 @@ __all__ = [
     "Outcome",
     "ParameterError",
     "Plate",
+    "PlateFileError",
     "PlateImpactError",
     "PluginRegistry",
     "ResistanceLaw",
@@ -81,6 +89,8 @@ __all__ = [
     "ResultRecorder",
     "Scene",
     "SceneBatch",
+    "ShotDataError",
+    "Shots",
     "Simulation",
     "Study",
     "StudyResults",
@@ -98,5 +108,6 @@ __all__ = [
     "load_registry",
     "presets",
     "run",
+    "synthetic_shots",
     "units",
 ]
