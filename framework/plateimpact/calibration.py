@@ -338,22 +338,18 @@ def newton_fit(
             correction = correction / 2  # guard the domain: damp the step
         else:
             raise ConvergenceError(
-                f"Newton iteration: the step from a = {a:.4g} N/m^2, b = {b:.4g} kg/m^3 was "
-                f"halved {MAX_HALVINGS} times and still left a, b > 0 or the model's "
-                "perforations"
+                _not_converged(
+                    f"after {iterations} iterations a step halved {MAX_HALVINGS} times still "
+                    "left a, b > 0 or the model's perforations",
+                    fits[0],
+                    target,
+                )
             )
         (a, b), residual, fits = trial, trial_residual, trial_fits
         iterations += 1
     if not converged and raise_on_failure:
-        hint = (
-            f"; R >= 1 needs b <= 0: no a, b > 0 reproduces R = {target.R:.4g}"
-            if target.R >= 1.0
-            else ""
-        )
         raise ConvergenceError(
-            f"Newton iteration did not converge in {max_iterations} iterations: model R = "
-            f"{fits[0].R:.5g}, V0 = {fits[0].V0:.5g} m/s against the shots' R = "
-            f"{target.R:.5g}, V0 = {target.V0:.5g} m/s{hint}"
+            _not_converged(f"no convergence in {max_iterations} iterations", fits[0], target)
         )
     # Uncertainty: the shots' (R, V0) covariance carried through the inverse Jacobian.
     relative_cov = target.covariance / np.outer(scale, scale)
@@ -361,6 +357,18 @@ def newton_fit(
     cov = inverse @ relative_cov @ inverse.T * np.outer([a, b], [a, b])
     return _calibration(
         "newton", plate, a, b, cov, iterations, converged, fits[0], target, normal, residual[0]
+    )
+
+
+def _not_converged(reason: str, model: DriFit, target: DriFit) -> str:
+    """One line: why the Newton iteration stopped, where it was, and why when known."""
+    hint = ""
+    if target.R >= 1.0:  # R² = exp(−2bW/m) < 1 for every b > 0 (energy_balance_start)
+        hint = "; no a, b > 0 gives R >= 1 (residual speeds rising faster than impact speed)"
+    return (
+        f"Newton iteration (eqs 44-49): {reason}; model R = {model.R:.5g}, V0 = "
+        f"{model.V0:.5g} m/s against the shots' R = {target.R:.5g}, V0 = {target.V0:.5g} m/s"
+        f"{hint}"
     )
 
 
