@@ -52,6 +52,7 @@ from .model import (
     TURNED_BACK,
     ImpactModel,
 )
+from .plate_file import load_plate_file, save_plate_file
 from .registry import PluginRegistry, default_registry, load_registry
 from .resistance import ResistanceLaw, contact_force
 from .results import BatchResult, Outcome, Result, Trajectory
@@ -122,10 +123,12 @@ __all__ = [
     "force_inclination",
     "geometry",
     "hookimpl",
+    "load_plate_file",
     "load_registry",
     "newton_fit",
     "presets",
     "run",
+    "save_plate_file",
     "synthetic_shots",
     "units",
 ]
