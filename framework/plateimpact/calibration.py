@@ -255,10 +255,9 @@ def _normal_shots(shots: Shots) -> Shots:
     normal = shots.normal_incidence()
     perforating = [label for label, p in zip(normal.labels, normal.perforated, strict=True) if p]
     if len(perforating) < MIN_PERFORATIONS:
-        source = shots.labels[0].rsplit(" ", 2)[0] if len(shots) else "shots"
         listed = f" ({', '.join(perforating)})" if perforating else ""
         raise ShotDataError(
-            f"{source}: {len(perforating)} perforating shots at normal incidence{listed}; "
+            f"{shots.source}: {len(perforating)} perforating shots at normal incidence{listed}; "
             f"the DRI fit needs at least {MIN_PERFORATIONS}"
         )
     return normal

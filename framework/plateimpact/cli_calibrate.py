@@ -10,12 +10,12 @@ import argparse
 import json
 import math
 import os
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from . import __version__
-from .bodies import Plate
+from .bodies import Plate, Sphere
 from .calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
 from .cli import (
     _add_model_options,
@@ -27,7 +27,11 @@ from .cli import (
 )
 from .plate_file import plate_file_text
 from .shots import Shots
+from .simulation import Simulation
 from .units import deg, g, mm
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: Model-curve points on the figure.
 CURVE_POINTS = 150
@@ -191,7 +195,8 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
         print(f"figure: {args.png}")
 
 
-def _figure(report: CalibrationReport, sphere: Any, simulation: Any) -> Any:
+def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
+    """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
     from . import plotting  # noqa: PLC0415
 
     normal = report.shots.normal_incidence()

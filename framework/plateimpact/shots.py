@@ -51,6 +51,8 @@ class Shots:
         :class:`~plateimpact.Outcome` values, 0 where not recorded.
     labels : tuple of str
         Where each shot came from (``shots.csv line 7``), for error messages.
+    source : str
+        The file (or ``"shots"``), for error messages about the whole set.
     """
 
     impact_speed: np.ndarray
@@ -59,6 +61,7 @@ class Shots:
     exit_obliquity: np.ndarray
     outcome: np.ndarray
     labels: tuple[str, ...]
+    source: str = "shots"
 
     def __len__(self) -> int:
         return int(self.impact_speed.size)
@@ -78,6 +81,7 @@ class Shots:
             self.exit_obliquity[kept],
             self.outcome[kept],
             tuple(self.labels[i] for i in kept),
+            self.source,
         )
 
     def normal_incidence(self) -> Shots:
@@ -261,6 +265,7 @@ def _parse_rows(rows: list[Mapping[str, object]], labels: list[str], source: str
         exit_obliquity=table[3] * deg,
         outcome=table[4].astype(int),
         labels=tuple(labels),
+        source=source,
     )
 
 
@@ -294,4 +299,5 @@ def synthetic_shots(
         exit_obliquity=np.where(perforated, result.exit_obliquity, np.nan),
         outcome=result.outcome.astype(int),
         labels=tuple(f"synthetic shot {i}" for i in range(speeds.size)),
+        source="synthetic shots",
     )
