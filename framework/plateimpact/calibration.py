@@ -289,10 +289,10 @@ def newton_fit(
     b [kg/m³]), by default :func:`energy_balance_start`. Each iteration runs the model at
     the normal-incidence shots' impact speeds at (a, b), (a + da, b) and (a, b + db), with
     da = ``step``·a, db = ``step``·b, in one batch, fits eq 40 to each, and solves eqs
-    48–49 for the correction. A step that leaves a, b > 0, or after which the model
-    perforates fewer than three of the speeds, is halved. Stops when R and V0 match the
-    shots' within ``tolerance`` (relative); otherwise :class:`ConvergenceError` after
-    ``max_iterations`` steps.
+    48–49 for the correction. A step that would make a or b <= 0, or after which the
+    model perforates at fewer than three of the speeds, is halved (up to 30 times).
+    Stops when R and V0 match the shots' within ``tolerance`` (relative); otherwise
+    :class:`ConvergenceError` after ``max_iterations`` steps.
     """
     simulation = simulation or Simulation.from_names()
     normal = _normal_shots(shots)
