@@ -12,11 +12,25 @@ from . import geometry, presets, units
 from .archive import Archive
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
+from .calibration import (
+    Calibration,
+    CalibrationReport,
+    DriFit,
+    calibrate,
+    direct_fit,
+    energy_balance_start,
+    fit_dri,
+    newton_fit,
+)
 from .errors import (
     ArchiveError,
+    CalibrationError,
+    ConvergenceError,
     IntegrationError,
     ParameterError,
+    PlateFileError,
     PlateImpactError,
+    ShotDataError,
     UnknownNameError,
 )
 from .failure import FailureModel
@@ -38,10 +52,12 @@ from .model import (
     TURNED_BACK,
     ImpactModel,
 )
+from .plate_file import load_plate_file, save_plate_file
 from .registry import PluginRegistry, default_registry, load_registry
 from .resistance import ResistanceLaw, contact_force
 from .results import BatchResult, Outcome, Result, Trajectory
 from .scene import Scene
+from .shots import Shots, synthetic_shots
 from .simulation import Simulation, run
 from .study import Comparison, Study, StudyResults, Variant
 
@@ -65,8 +81,13 @@ __all__ = [
     "TURNED_BACK",
     "Archive",
     "ArchiveError",
+    "CalibrationError",
+    "CalibrationReport",
+    "ConvergenceError",
     "BatchResult",
+    "Calibration",
     "Comparison",
+    "DriFit",
     "FailureModel",
     "ImpactModel",
     "IntegrationError",
@@ -74,6 +95,7 @@ __all__ = [
     "Outcome",
     "ParameterError",
     "Plate",
+    "PlateFileError",
     "PlateImpactError",
     "PluginRegistry",
     "ResistanceLaw",
@@ -81,6 +103,8 @@ __all__ = [
     "ResultRecorder",
     "Scene",
     "SceneBatch",
+    "ShotDataError",
+    "Shots",
     "Simulation",
     "Study",
     "StudyResults",
@@ -88,15 +112,23 @@ __all__ = [
     "Trajectory",
     "UnknownNameError",
     "Variant",
+    "calibrate",
     "contact_force",
     "contact_geometry",
     "contact_lost_margin",
     "default_registry",
+    "direct_fit",
+    "energy_balance_start",
+    "fit_dri",
     "force_inclination",
     "geometry",
     "hookimpl",
+    "load_plate_file",
     "load_registry",
+    "newton_fit",
     "presets",
     "run",
+    "save_plate_file",
+    "synthetic_shots",
     "units",
 ]

@@ -24,6 +24,7 @@ from .archive import Archive
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .errors import ParameterError, PlateImpactError
+from .plate_file import load_plate_file
 from .results import BatchResult, Outcome
 from .scene import Scene
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
@@ -95,6 +96,12 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
 def _add_body_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("plate and sphere (override the preset)")
     group.add_argument("--preset", help=f"plate preset: {', '.join(presets.PLATES)}")
+    group.add_argument(
+        "--plate-file",
+        metavar="FILE",
+        help="plate from a plate file (JSON, e.g. written by 'plateimpact calibrate --out'); "
+        "not with --preset or the plate options",
+    )
     group.add_argument("--thickness", type=float, help="plate thickness T [mm]")
     group.add_argument("--a", type=float, help="Poncelet strength term a [N/m^2]")
     group.add_argument("--b", type=float, help="Poncelet inertial term b [kg/m^3]")
@@ -138,6 +145,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", metavar="FILE", help="write CSV here (default: standard output)")
     _add_body_options(p)
     _add_model_options(p)
+
+    from .cli_calibrate import add_calibrate_parser  # noqa: PLC0415 (it imports this module)
+
+    add_calibrate_parser(sub)
 
     p = sub.add_parser("reproduce", help="run the report's figure families into one archive")
     p.add_argument("--out", default="report", help="output directory, created (default: report)")
@@ -183,7 +194,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _bodies(args: argparse.Namespace) -> tuple[Sphere, Plate, str]:
     plate_flags = ("thickness", "a", "b", "pstar", "alpha")
-    if args.preset is None:
+    if args.plate_file is not None:
+        given = ["--preset"] * (args.preset is not None)
+        given += [f"--{f}" for f in plate_flags if getattr(args, f) is not None]
+        if given:
+            raise UsageError(f"--plate-file cannot be combined with {', '.join(given)}")
+        base, label = load_plate_file(args.plate_file), os.path.basename(args.plate_file)
+    elif args.preset is None:
         missing = [f"--{f}" for f in plate_flags if getattr(args, f) is None]
         if missing:
             raise UsageError(
@@ -209,6 +226,11 @@ def _bodies(args: argparse.Namespace) -> tuple[Sphere, Plate, str]:
         plate = attrs.evolve(base, **overrides) if overrides else base
         if overrides:
             label = f"{label}+custom"
+    return _sphere(args), plate, label
+
+
+def _sphere(args: argparse.Namespace) -> Sphere:
+    """The default sphere, or the one of --radius [mm] and --mass [g]."""
     sphere = presets.DEFAULT_SPHERE
     if args.radius is not None or args.mass is not None:
         radius = args.radius * mm if args.radius is not None else sphere.radius
@@ -216,7 +238,7 @@ def _bodies(args: argparse.Namespace) -> tuple[Sphere, Plate, str]:
             sphere = Sphere(radius=radius, mass=args.mass * g)
         else:  # a new radius keeps the default sphere's density
             sphere = Sphere.of_density(radius, presets.SAE_52100_DENSITY)
-    return sphere, plate, label
+    return sphere
 
 
 def _simulation(args: argparse.Namespace) -> Simulation:
@@ -276,6 +298,21 @@ def _write_atomically(path: str, text: str, flag: str) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def _save_figure_atomically(fig: Any, path: str) -> None:
+    """Save a matplotlib figure to ``path`` [PNG] so that no partial file is left behind."""
+    from . import plotting
+
+    directory = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".png")
+    os.close(fd)
+    try:
+        plotting.save(fig, tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
 
 
 def _cmd_presets(args: argparse.Namespace) -> None:
@@ -385,15 +422,7 @@ def _cmd_crater(args: argparse.Namespace) -> None:
         fig, ax = plotting.plt.subplots(figsize=(8, 4))
         plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=sphere.radius)
         ax.set_title(f"{label}, {args.speed:g} m/s at {args.obliquity:g}°: {result.outcome.label}")
-        directory = os.path.dirname(os.path.abspath(args.png))
-        fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".png")
-        os.close(fd)
-        try:
-            plotting.save(fig, tmp)
-            os.replace(tmp, args.png)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        _save_figure_atomically(fig, args.png)
 
 
 def _cmd_sweep(args: argparse.Namespace) -> None:
@@ -433,12 +462,19 @@ def _cmd_sweep(args: argparse.Namespace) -> None:
         )
 
 
+def _cmd_calibrate(args: argparse.Namespace) -> None:
+    from .cli_calibrate import calibrate_command  # noqa: PLC0415 (it imports this module)
+
+    calibrate_command(args)
+
+
 COMMANDS = {
     "presets": _cmd_presets,
     "plugins": _cmd_plugins,
     "run": _cmd_run,
     "crater": _cmd_crater,
     "sweep": _cmd_sweep,
+    "calibrate": _cmd_calibrate,
 }
 
 

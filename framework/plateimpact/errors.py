@@ -37,3 +37,21 @@ class IntegrationError(PlateImpactError, RuntimeError):
 class ArchiveError(PlateImpactError, OSError):
     """An archive cannot be written or read: missing directory, not HDF5, a checksum
     mismatch, another process writing it."""
+
+
+class ShotDataError(PlateImpactError, ValueError):
+    """Shot data (impact and residual speeds) cannot be read or fails a check; the
+    message names the file, line and column."""
+
+
+class PlateFileError(PlateImpactError, ValueError):
+    """A plate file cannot be read or holds an invalid plate."""
+
+
+class CalibrationError(PlateImpactError, RuntimeError):
+    """No a, b can be found from the shots: too few perforations, a DRI fit outside the
+    model's range, or an iteration that did not converge."""
+
+
+class ConvergenceError(CalibrationError):
+    """The report's Newton iteration (eqs 44–49) did not converge within its iterations."""

@@ -1,0 +1,225 @@
+"""``plateimpact calibrate``: a and b from shots at normal incidence (eqs 40–49).
+
+Registered into :mod:`plateimpact.cli` (which imports this module only when the command
+is built or run, so that this module may import the command line's helpers).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import __version__
+from .bodies import Plate, Sphere
+from .calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
+from .cli import (
+    _add_model_options,
+    _check_directory,
+    _save_figure_atomically,
+    _simulation,
+    _sphere,
+    _write_atomically,
+)
+from .plate_file import plate_file_text
+from .shots import Shots
+from .simulation import Simulation
+from .units import deg, g, mm
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+#: Model-curve points on the figure.
+CURVE_POINTS = 150
+
+
+def add_calibrate_parser(sub: Any) -> None:
+    """Add the ``calibrate`` sub-command to the sub-parsers ``sub``."""
+    p = sub.add_parser(
+        "calibrate",
+        help="fit a and b to residual speeds at normal incidence (DRI fit, eqs 40-49)",
+        description="Fit the Poncelet constants a and b to shots at normal incidence: the "
+        "DRI fit (eqs 40-41), the report's Newton iteration (eqs 44-49) and a direct "
+        "least-squares fit. P* and alpha* are given (from craters, as in the report).",
+    )
+    p.add_argument(
+        "shots",
+        metavar="SHOTS.csv",
+        help="columns impact_speed_m_s,impact_obliquity_deg,residual_speed_m_s"
+        "[,exit_obliquity_deg,outcome] in any order; residual 0: no perforation",
+    )
+    p.add_argument("--thickness", type=float, required=True, help="plate thickness T [mm]")
+    p.add_argument("--pstar", type=float, required=True, help="critical penetration P* [mm]")
+    p.add_argument("--alpha", type=float, required=True, help="failure angle alpha* [deg]")
+    p.add_argument("--radius", type=float, help="sphere radius Rs [mm] (default 3.175)")
+    p.add_argument("--mass", type=float, help="sphere mass m [g] (default 1.0498)")
+    p.add_argument("--material", default="calibrated", help="material label of the plate")
+    p.add_argument(
+        "--method",
+        choices=("newton", "direct"),
+        default="newton",
+        help="whose a, b are headlined and written to --out (default: newton, the report's)",
+    )
+    p.add_argument("--out", metavar="PLATE.json", help="write the calibrated plate file here")
+    p.add_argument("--png", metavar="FILE", help="draw data, DRI curve and model curves here")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_model_options(p)
+
+
+def calibrate_command(args: argparse.Namespace) -> None:
+    """Run ``plateimpact calibrate``."""
+    _check_directory(args.out, "--out")
+    _check_directory(args.png, "--png")
+    shots = Shots.from_csv(args.shots)
+    sphere = _sphere(args)
+    # a and b of this plate are placeholders: the calibration replaces them.
+    plate = Plate(args.material, args.thickness * mm, 1.0, 1.0, args.pstar * mm, args.alpha * deg)
+    simulation = _simulation(args)
+    report = calibrate(shots, plate, sphere=sphere, simulation=simulation)
+    chosen = report.newton if args.method == "newton" else report.direct
+    summary = _summary(args, report, chosen)
+    summary["model"] = simulation.describe()
+    if args.out is not None:
+        extra = {"calibration": {**_provenance(args, report, chosen), "model": summary["model"]}}
+        _write_atomically(args.out, plate_file_text(chosen.plate, extra), "--out")
+    if args.png is not None:
+        _save_figure_atomically(_figure(report, sphere, simulation), args.png)
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        _print_text(args, report, chosen)
+
+
+def _finite(x: float) -> float | None:
+    """``x``, or None (JSON null) where it is NaN: a standard error with no residual left."""
+    return x if math.isfinite(x) else None
+
+
+def _method_dict(fit: Calibration) -> dict[str, Any]:
+    return {
+        "a_N_m2": fit.a,
+        "a_stderr_N_m2": _finite(fit.a_stderr),
+        "b_kg_m3": fit.b,
+        "b_stderr_kg_m3": _finite(fit.b_stderr),
+        "correlation": fit.correlation,
+        "iterations": fit.iterations,
+        "converged": fit.converged,
+        "model_R": fit.model_fit.R,
+        "model_V0_m_s": fit.model_fit.V0,
+        "rms_residual_m_s": fit.rms_residual,
+    }
+
+
+def _summary(
+    args: argparse.Namespace, report: CalibrationReport, chosen: Calibration
+) -> dict[str, Any]:
+    normal = report.shots.normal_incidence()
+    return {
+        "shots_file": args.shots,
+        "shots": len(report.shots),
+        "normal_incidence_shots": len(normal),
+        "perforating_shots": int(normal.perforated.sum()),
+        "method": chosen.method,
+        "a_N_m2": chosen.a,
+        "a_stderr_N_m2": _finite(chosen.a_stderr),
+        "b_kg_m3": chosen.b,
+        "b_stderr_kg_m3": _finite(chosen.b_stderr),
+        "R": report.dri.R,
+        "R_stderr": report.dri.R_stderr,
+        "V0_m_s": report.dri.V0,
+        "V0_stderr_m_s": report.dri.V0_stderr,
+        "dri_rms_residual_m_s": report.dri.rms_residual,
+        "newton": _method_dict(report.newton),
+        "direct": _method_dict(report.direct),
+        "plate_file": args.out,
+    }
+
+
+def _provenance(
+    args: argparse.Namespace, report: CalibrationReport, chosen: Calibration
+) -> dict[str, Any]:
+    sphere = _sphere(args)
+    return {
+        "method": chosen.method,
+        "shots_file": os.path.basename(args.shots),
+        "a_stderr_N_m2": _finite(chosen.a_stderr),
+        "b_stderr_kg_m3": _finite(chosen.b_stderr),
+        "R": report.dri.R,
+        "V0_m_s": report.dri.V0,
+        "sphere": {"radius_mm": sphere.radius / mm, "mass_g": sphere.mass / g},
+        "plateimpact_version": __version__,
+    }
+
+
+def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Calibration) -> None:
+    normal = report.shots.normal_incidence()
+    ignored = len(report.shots) - len(normal)
+    dri = report.dri
+    print(
+        f"shots: {args.shots}: {len(normal)} at normal incidence, "
+        f"{int(normal.perforated.sum())} perforating"
+        + (f" ({ignored} oblique shots not used)" if ignored else "")
+    )
+    print(
+        f"DRI fit (eqs 40-41): R = {dri.R:.5g} ± {dri.R_stderr:.2g}, "
+        f"V0 = {dri.V0:.5g} ± {dri.V0_stderr:.2g} m/s, rms residual {dri.rms_residual:.3g} m/s"
+    )
+    print(
+        f"{'':22s}{'a [N/m^2]':>22s}{'b [kg/m^3]':>20s}{'steps':>7s}"
+        f"{'model R':>10s}{'model V0':>10s}{'rms [m/s]':>10s}"
+    )
+    for name, fit in (
+        ("newton (eqs 44-49)", report.newton),
+        ("direct least squares", report.direct),
+    ):
+        print(
+            f"{name:22s}{f'{fit.a:.5g} ± {fit.a_stderr:.2g}':>22s}"
+            f"{f'{fit.b:.5g} ± {fit.b_stderr:.2g}':>20s}{fit.iterations:7d}"
+            f"{fit.model_fit.R:10.5g}{fit.model_fit.V0:10.5g}{fit.rms_residual:10.3g}"
+        )
+    newton, direct = report.newton, report.direct
+    print(
+        f"direct - newton: a {100 * (direct.a / newton.a - 1):+.3g} %, "
+        f"b {100 * (direct.b / newton.b - 1):+.3g} % "
+        f"({abs(direct.a - newton.a) / newton.a_stderr:.2g} and "
+        f"{abs(direct.b - newton.b) / newton.b_stderr:.2g} standard errors of newton)"
+    )
+    print(f"plate ({chosen.method}): a = {chosen.a:.6g} N/m^2, b = {chosen.b:.6g} kg/m^3")
+    if args.out is not None:
+        print(f"plate file: {args.out}")
+    if args.png is not None:
+        print(f"figure: {args.png}")
+
+
+def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
+    """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
+    from . import plotting  # noqa: PLC0415
+
+    normal = report.shots.normal_incidence()
+    speeds = np.linspace(
+        0.8 * normal.impact_speed.min(), 1.05 * normal.impact_speed.max(), CURVE_POINTS
+    )
+    fits = (report.newton, report.direct)
+    curves = model_residual_speeds(
+        simulation, sphere, fits[0].plate, speeds, [(f.a, f.b) for f in fits]
+    )
+    fig, ax = plotting.plt.subplots(figsize=(7, 5))
+    plotting.plot_calibration(
+        ax,
+        normal,
+        report.dri,
+        {
+            f"model, {fit.method}: a = {fit.a:.3g} N/m², b = {fit.b:.3g} kg/m³": (speeds, curve)
+            for fit, curve in zip(fits, curves, strict=True)
+        },
+    )
+    plate = fits[0].plate
+    ax.set_title(
+        f"{plate.material}, T = {plate.thickness / mm:g} mm, P* = "
+        f"{plate.critical_penetration / mm:g} mm: residual speed at normal incidence"
+    )
+    return fig
