@@ -242,6 +242,7 @@ class Archive:
         if not self.path.parent.is_dir():
             raise ArchiveError(f"archive {self.path}: directory {self.path.parent} does not exist")
         with self._lock():
+            self._remove_stale_copies()
             temporary = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
             try:
                 if self.path.exists():
@@ -297,6 +298,12 @@ class Archive:
                 f"the archive already holds a different study named {study.name!r}; "
                 "rename the study"
             )
+
+    def _remove_stale_copies(self) -> None:
+        """Delete the temporary copies left by writers killed mid-append: we hold the
+        lock, so no other writer is using one."""
+        for copy in self.path.parent.glob(f".{self.path.name}.*.tmp"):
+            copy.unlink(missing_ok=True)
 
     @staticmethod
     def _study_group(f: h5py.File, study: Study) -> h5py.Group:
