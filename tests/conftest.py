@@ -58,7 +58,7 @@ try:
         suppress_health_check=[HealthCheck.too_slow],
     )
     settings.register_profile(
-        "stress", max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+        "stress", max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow]
     )
     settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 except ImportError:  # hypothesis is a test extra

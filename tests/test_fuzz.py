@@ -150,3 +150,56 @@ def test_damaged_run_attributes_give_archive_error(archive_bytes, tmp_path):
     path.write_bytes(labels)
     with pytest.raises(pi.ArchiveError, match="digest"):
         pi.Archive(path).study()
+
+
+SHOT_COLUMNS = [
+    "impact_speed_m_s",
+    "impact_obliquity_deg",
+    "residual_speed_m_s",
+    "exit_obliquity_deg",
+    "outcome",
+    "note",
+]
+CELLS = st.sampled_from(
+    ["0", "500", "700", "900", "1200", "-3", "nan", "inf", "", "abc", "perforation", "ricochet",
+     "embedment", "1e400", "45", "0.0", "350", "2000", '"x,y"']
+)  # fmt: skip
+
+
+@given(
+    header=st.lists(st.sampled_from(SHOT_COLUMNS), max_size=6),
+    rows=st.lists(st.lists(CELLS, max_size=7), max_size=6),
+)
+def test_malformed_shot_files_give_one_line_errors(header, rows):
+    with tempfile.TemporaryDirectory() as directory:
+        path = Path(directory) / "shots.csv"
+        lines = [",".join(header)] + [",".join(row) for row in rows]
+        path.write_text("\n".join(lines) + "\n")
+        argv = ["calibrate", str(path), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
+        assert_clean(*run_cli(argv))
+
+
+PLATE_VALUES = st.one_of(
+    st.sampled_from([3.18, 0.0, -1.0, float("nan"), float("inf"), 1e9, 45.0, 90.0]),
+    st.sampled_from(["3.18", "", None, True, [], {}]),
+)
+
+
+@given(
+    fields=st.dictionaries(
+        st.sampled_from(
+            ["format", "material", "thickness_mm", "pstar_mm", "alpha_deg", "a_N_m2", "b_kg_m3"]
+        ),
+        PLATE_VALUES,
+    ),
+    garbage=st.binary(max_size=20),
+)
+def test_malformed_plate_files_give_one_line_errors(fields, garbage):
+    import json  # noqa: PLC0415
+
+    with tempfile.TemporaryDirectory() as directory:
+        for n, content in enumerate([json.dumps(fields).encode(), garbage]):
+            path = Path(directory) / f"plate{n}.json"
+            path.write_bytes(content)
+            argv = ["run", "--plate-file", str(path), "--speed", "500", "--obliquity", "30"]
+            assert_clean(*run_cli(argv))
