@@ -22,11 +22,13 @@ from collections.abc import Sequence
 
 import attrs
 import numpy as np
+from scipy.integrate import quad
 from scipy.optimize import least_squares
 
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .errors import CalibrationError, ConvergenceError, ShotDataError
+from .geometry import contact_geometry
 from .presets import DEFAULT_SPHERE
 from .results import Outcome
 from .shots import Shots
@@ -200,15 +202,19 @@ def swept_volume(sphere: Sphere, plate: Plate) -> float:
     if not math.isfinite(pstar):
         raise CalibrationError("a plate that never fails (P* = inf) cannot be perforated")
 
-    def area_integral(p: float) -> float:  # ∫0^p A dP [m³]
-        if p <= 0.0:
+    def area(p: float) -> float:  # A at θ = 0 from the core geometry: eqs 2–6 exist once
+        return float(contact_geometry(np.array([p]), np.zeros(1), np.array([rs]))[0][0])
+
+    def area_integral(lo: float, hi: float) -> float:  # ∫ A dP [m³]; A has a kink at Rs
+        if hi <= lo:
             return 0.0
-        q = min(p, rs)
-        return math.pi * (rs * q**2 - q**3 / 3) + math.pi * rs**2 * max(p - rs, 0.0)
+        points = [rs] if lo < rs < hi else None
+        return quad(area, lo, hi, points=points, epsabs=0.0, epsrel=1e-13, limit=200)[0]
 
     h = max(rs * math.cos(plate.failure_angle) + pstar - rs, 0.0)
     end = max(h + rs, pstar)
-    return area_integral(end) - (area_integral(end - h) - area_integral(pstar - h))
+    # The intact area up to perforation, less the relieved area beyond the plane after P*.
+    return area_integral(0.0, end) - area_integral(max(pstar - h, 0.0), end - h)
 
 
 def energy_balance_start(
