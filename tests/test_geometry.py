@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from plateimpact.geometry import (
+    branch_margins,
     contact_geometry,
     contact_lost_margin,
     entry_edge_angle,
@@ -61,6 +62,35 @@ def test_area_and_inclination_are_continuous_across_branch_boundaries(theta):
         above = contact_geometry(np.array([p_b + eps]), np.array([theta]), np.array([RS]))
         assert abs(above[0][0] - below[0][0]) < 1e-6 * RS**2, p_b
         assert abs(above[1][0] - below[1][0]) < 1e-6, p_b
+
+
+def _second_difference_order(p, theta):
+    """Slope of log|A(p+δ) − 2A(p) + A(p−δ)| against log δ: 2 where A is smooth."""
+    steps = np.array([1e-3, 1e-4, 1e-5]) * RS
+    values = [
+        abs(area(p + d, theta)[0] - 2 * area(p, theta)[0] + area(p - d, theta)[0]) for d in steps
+    ]
+    return np.polyfit(np.log(steps), np.log(values), 1)[0]
+
+
+@pytest.mark.parametrize("theta", np.radians([20.0, 45.0, 70.0]))
+def test_branch_margins_vanish_where_the_area_stops_being_smooth(theta):
+    first, second = RS * (1.0 - np.sin(theta)), RS * (1.0 + np.sin(theta))
+    margins = branch_margins(np.array([first, second]), np.full(2, theta), np.full(2, RS))
+    np.testing.assert_allclose(np.diag(margins), 0.0, atol=1e-15)
+    assert np.all(np.diag(margins[::-1]) != 0.0)  # and each only on its own surface
+    # First surface: a circular segment appears, its area growing as depth^{3/2}, so the
+    # second difference across it falls as δ^{3/2}, not δ² as it does between them.
+    assert 1.4 < _second_difference_order(first, theta) < 1.6
+    assert 1.9 < _second_difference_order(0.5 * (first + second), theta) < 2.1
+    # Second surface: the whole forward hemisphere is below, A = πRs² beyond it and
+    # curved before it, so A″ jumps there.
+    d = 1e-4 * RS
+    before = (
+        area(second, theta) - 2 * area(second - d, theta) + area(second - 2 * d, theta)
+    ) / d**2
+    after = (area(second + 2 * d, theta) - 2 * area(second + d, theta) + area(second, theta)) / d**2
+    assert abs(before[0]) > 0.5 and after[0] == 0.0
 
 
 @pytest.mark.parametrize("p", [0.05, 0.3, 0.6, 0.9, 0.99])

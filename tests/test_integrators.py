@@ -85,7 +85,7 @@ def reference(scenes):
 
 
 def test_default_integrator_meets_its_accuracy_target(scenes, reference):
-    # The default (dopri5, rtol 1e-10) against DOP853 at rtol 1e-12: exit speed within
+    # The default (dopri5 at its default rtol) against DOP853 at rtol 1e-12: exit speed within
     # 1e-6 of the impact speed, exit obliquity within 1e-4°, same outcomes.
     result = pi.Simulation.from_names().run_batch(scenes)
     speed = np.array([s.impact_speed for s in scenes])
@@ -96,6 +96,31 @@ def test_default_integrator_meets_its_accuracy_target(scenes, reference):
         np.degrees(np.max(np.abs(result.exit_obliquity - reference.exit_obliquity)[flying])) <= 1e-4
     )
     np.testing.assert_allclose(result.max_penetration, reference.max_penetration, rtol=1e-7)
+
+
+@pytest.mark.parametrize("failure", ["plugging", "hinge"])
+def test_stepping_onto_branch_surfaces_cuts_rejections_and_error(failure, scenes):
+    """A step that straddles a surface where the force stops being smooth (the contact
+    geometry's branches, the hinge's θ1) is rejected again and again, and when one is
+    accepted its error exceeds its estimate. Stepping onto the surface first does better
+    on both counts (measured: 3× fewer rejections, 35× smaller errors)."""
+    reference = pi.Simulation.from_names(
+        failure=failure, integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
+    ).run_batch(scenes)
+    speed = np.array([s.impact_speed for s in scenes])
+    flying = reference.outcome != pi.Outcome.EMBEDMENT
+    runs = {}
+    for landing in (True, False):
+        result = pi.Simulation.from_names(
+            failure=failure, integrator_settings={"rtol": 1e-8, "branch_landing": landing}
+        ).run_batch(scenes)
+        np.testing.assert_array_equal(result.outcome, reference.outcome)
+        speed_error = np.max(np.abs(result.exit_speed - reference.exit_speed) / speed)
+        turn_error = np.max(np.abs(result.exit_obliquity - reference.exit_obliquity)[flying])
+        runs[landing] = (result.stats["rejected_steps"], speed_error, turn_error)
+    (rejected, speed_error, turn_error), (rejected_off, speed_off, turn_off) = runs.values()
+    assert rejected < 0.5 * rejected_off, runs
+    assert speed_error < 0.2 * speed_off and turn_error < 0.2 * turn_off, runs
 
 
 @pytest.mark.parametrize("integrator", ["dopri5", "solve_ivp"])
@@ -147,6 +172,7 @@ def test_bad_integrator_settings_name_the_setting():
     for name, settings, parameter in [
         ("dopri5", {"rtol": 0.5}, "rtol"),
         ("dopri5", {"fixed_step": 2.0}, "fixed_step"),
+        ("dopri5", {"branch_landing": "yes"}, "branch_landing"),
         ("solve_ivp", {"method": "Euler"}, "method"),
         ("solve_ivp", {"rtol": 0.0}, "rtol"),
     ]:

@@ -68,6 +68,24 @@ class FailureModel(ABC):
     ) -> np.ndarray:
         """A length [m] that crosses zero upward when perforation is complete."""
 
+    def branch_margins(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        """Margins that cross zero where :meth:`force_change` or :meth:`state_rates`
+        switches formula, shape (rows, n), any unit per row (default: none).
+
+        The force stays continuous there but not smooth, and an error-controlled step
+        that straddles such a surface is both costly and less accurate than its error
+        estimate claims; the adaptive integrator steps onto it instead (docs/
+        integrators.md, "branch surfaces"). Called only for failed scenes; a row is only
+        ever compared in sign with itself, so rows may mix units.
+        """
+        return np.empty((0, np.shape(penetration)[0]))
+
     def initial_state(
         self,
         penetration: np.ndarray,

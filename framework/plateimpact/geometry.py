@@ -130,6 +130,23 @@ def contact_geometry(
     return area, phi
 
 
+def branch_margins(
+    penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
+) -> np.ndarray:
+    """P − Rs(1 − sin θ) and P − Rs(1 + sin θ) [m], shape (2, n): zero on the two surfaces
+    where eqs 2–6 change branch.
+
+    On the first, the edge of the forward hemisphere reaches the front plane (Γs leaves 0,
+    Γe leaves 2π, φ leaves its clamp at 0); on the second, it leaves the plate at the
+    back of the crater (φ reaches θ). There the presented area is continuous but not
+    smooth: a circular segment appears with an area that grows as (depth)^{3/2}, and φ
+    has a corner. An adaptive integrator steps onto these surfaces rather than across
+    them (docs/integrators.md, "branch surfaces"). θ in [0, π].
+    """
+    lift = radius * np.sin(obliquity)
+    return np.stack([penetration - (radius - lift), penetration - (radius + lift)])
+
+
 def contact_lost_margin(
     penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
 ) -> np.ndarray:

@@ -10,7 +10,7 @@ import numpy as np
 from . import validation as v
 from .batch import SceneBatch
 from .failure import FailureModel
-from .geometry import contact_lost_margin
+from .geometry import branch_margins, contact_lost_margin
 from .resistance import ResistanceLaw, contact_force
 from .results import Outcome
 
@@ -204,6 +204,26 @@ class ImpactModel:
         if kind == TURNED_BACK:
             return np.where(held, -np.inf, obl - (self.MAX_OBLIQUITY - self.TURN_BACK_TOLERANCE))
         raise ValueError(f"no event {kind}")
+
+    def branch_margins(self, y: np.ndarray, failed: np.ndarray, batch: SceneBatch) -> np.ndarray:
+        """Margins that cross zero where the force changes formula, shape (rows, n): the
+        contact geometry's branch surfaces (:func:`geometry.branch_margins`), then the
+        failure model's rows (:meth:`FailureModel.branch_margins`), NaN for intact scenes.
+
+        Not events: nothing changes there but the smoothness of the force. An adaptive
+        integrator uses them to step onto such a surface rather than across it.
+        """
+        pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
+        rows = branch_margins(pen, obl, batch.radius)
+        if not failed.any():
+            return rows
+        index = np.flatnonzero(failed)
+        failure_rows = self.failure.branch_margins(
+            pen[index], obl[index], y[KINEMATIC_STATE:, index], batch.take(index)
+        )
+        extra = np.full((failure_rows.shape[0], pen.size), np.nan)
+        extra[:, index] = failure_rows
+        return np.concatenate([rows, extra])
 
     def perforation_margin(
         self,

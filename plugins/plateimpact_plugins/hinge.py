@@ -110,6 +110,20 @@ class Hinge(PlaneSeparation):
         peeling = np.maximum(obliquity_rate + speed / batch.radius, 0.0)  # eq 18 per unit time
         return np.where(held | (finger_angle <= 0.0), 0.0, -peeling)[np.newaxis]
 
+    def branch_margins(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        # Besides the relief's: θ − θ1 [rad], where ψ″ switches from eq 19 to eq 20 and β
+        # starts to shrink, and β [rad], which stops the finger at 0.
+        finger_rows = np.stack([obliquity - batch.hinge_obliquity, state[0]])
+        return np.concatenate(
+            [super().branch_margins(penetration, obliquity, state, batch), finger_rows]
+        )
+
     def finger(
         self, obliquity: np.ndarray, finger_angle: np.ndarray, batch: SceneBatch
     ) -> tuple[np.ndarray, np.ndarray]:

@@ -6,7 +6,7 @@ from abc import abstractmethod
 
 import numpy as np
 
-from plateimpact import FailureModel, ResistanceLaw, SceneBatch, contact_force
+from plateimpact import FailureModel, ResistanceLaw, SceneBatch, contact_force, geometry
 
 
 class PlaneSeparation(FailureModel):
@@ -58,6 +58,18 @@ class PlaneSeparation(FailureModel):
         law: ResistanceLaw,
     ) -> tuple[np.ndarray, np.ndarray]:
         return self.relief(penetration, obliquity, speed, batch, law)
+
+    def branch_margins(
+        self,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        state: np.ndarray,
+        batch: SceneBatch,
+    ) -> np.ndarray:
+        # The relieved force is eqs 2–6 below the failure plane: the same branch surfaces
+        # with P − h for P [m].
+        below_plane = penetration - batch.failure_plane_depth
+        return geometry.branch_margins(below_plane, obliquity, batch.radius)
 
     def perforation_margin(
         self, penetration: np.ndarray, obliquity: np.ndarray, batch: SceneBatch
