@@ -150,6 +150,14 @@ def branch_margins(
 def contact_lost_margin(
     penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
 ) -> np.ndarray:
-    """(θ − π/2) − α1 [rad]: >= 0 once the sphere moves away from every point of the
-    plate (the forward hemisphere and the below-surface cap no longer meet)."""
-    return (obliquity - HALF_PI) - entry_edge_angle(penetration, radius)
+    """>= 0 once the sphere moves away from every point of the plate (the forward
+    hemisphere and the below-surface cap no longer meet): θ − π/2 >= α1.
+
+    Written without α1's arccos, whose slope is infinite at P = 0, where shallow
+    ricochets end: for θ >= π/2 both angles lie in [0, π], where the cosine decreases, so
+    the condition is cos α1 = (Rs − P)/Rs >= cos(θ − π/2) = sin θ. The margin is
+    min(θ − π/2 [rad], (Rs − P)/Rs − sin θ): zero on the same surface as θ − π/2 − α1
+    and of the same sign everywhere, but smooth across it, so its root is found in
+    fewer iterations. θ in [0, π].
+    """
+    return np.minimum(obliquity - HALF_PI, (radius - penetration) / radius - np.sin(obliquity))
