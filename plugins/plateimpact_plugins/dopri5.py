@@ -21,11 +21,14 @@ class DormandPrince54(EmbeddedRungeKutta):
     ----------
     rtol : float
         Local error tolerance relative to each component's scale, in [1e-14, 1e-2];
-        default 3e-10 (exit speed within 1e-6 of the impact speed and exit obliquity within
-        1e-4° of the reference on the benchmark set: docs/integrators.md).
+        default 1e-8 (exit speed within 2e-7 of the impact speed and exit obliquity within
+        1e-5° of the reference on the benchmark set: docs/integrators.md).
     max_steps : int
     fixed_step : float or None
         A constant step [fraction of Rs/Vs] without error control, for convergence studies.
+    branch_landing : bool
+        Step onto the surfaces where the force stops being smooth instead of across them
+        (default True; False only to measure what that saves).
     """
 
     name = "dopri5"

@@ -84,11 +84,16 @@ class EmbeddedRungeKutta(Integrator):
     together, one step per iteration, as numpy arrays; finished scenes leave the set.
 
     Events (``ImpactModel.event_margins``) are located in every accepted step on the dense
-    output: sampled at EVENT_SAMPLES, then bisected in the first sub-step where a margin
-    goes from < 0 to >= 0, to the last bit of the step. The step is cut there and the
-    integration restarts with the new force law (failure onset, θ held at 180°) or the
-    scene ends (contact lost, perforation, rest). The maximum penetration is located the
-    same way, where θ crosses 90°.
+    output: sampled at EVENT_SAMPLES, then refined in the first sub-step where a margin
+    goes from < 0 to >= 0. The step is cut there and the integration restarts with the
+    new force law (failure onset, θ held at 180°) or the scene ends (contact lost,
+    perforation, rest). The maximum penetration is located the same way, where θ
+    crosses 90°.
+
+    Branch surfaces (``ImpactModel.branch_margins``), where the force is continuous but
+    not smooth, are not stepped across: a step predicted to cross one is shortened to
+    end just before it, and the next crosses it with a short step (``branch_landing``;
+    docs/integrators.md, "branch surfaces").
     """
 
     C: ClassVar[np.ndarray]
