@@ -201,3 +201,43 @@ def test_chunks_concatenate_to_the_whole():
     for name, column in whole.trajectory.items():
         np.testing.assert_array_equal(column, joined.trajectory[name], err_msg=name)
     assert joined.trajectory_of(45).time.size == whole.trajectory_of(45).time.size
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e3])
+def test_event_root_finding_stops_within_a_few_iterations_on_the_event_side(offset):
+    """Event refinement on a cubic dense output, y(σ) = σ + 0.3σ² − 0.2σ³, for 200 levels:
+    the returned σ is on the event's side of the margin (>= 0), within the documented
+    resolution of the root, and reached in a handful of margin evaluations, also when the
+    margin is a difference of numbers 1e3 times larger (where rounding blurs the root and
+    the iteration once bounced to its 16-step cap)."""
+    from plateimpact_plugins.event_location import EVENT_SAMPLES, dense_state, locate
+
+    levels = np.random.default_rng(1).uniform(0.05, 1.0, 200)
+    coefficients = np.zeros((3, 1, levels.size))
+    coefficients[:, 0] = np.array([1.0, 0.3, -0.2])[:, np.newaxis]
+    start = np.zeros((1, levels.size))
+    calls = []
+
+    def margin(state):
+        calls.append(1)
+        return (offset + state[0]) - (offset + levels)
+
+    def path(sigma):
+        return sigma + 0.3 * sigma**2 - 0.2 * sigma**3
+
+    at_samples = path(EVENT_SAMPLES)[:, np.newaxis]
+    first = np.argmax((at_samples[:-1] < levels) & (at_samples[1:] >= levels), axis=0)
+    lo, hi = EVENT_SAMPLES[first], EVENT_SAMPLES[first + 1]
+    sigma = locate(
+        margin,
+        start,
+        coefficients,
+        lo,
+        hi,
+        (offset + path(lo)) - (offset + levels),
+        (offset + path(hi)) - (offset + levels),
+    )
+    evaluations = len(calls)
+    assert np.all(margin(dense_state(start, coefficients, sigma)) >= 0.0)
+    assert np.max(np.abs(path(sigma) - levels)) < 1e-10
+    assert evaluations <= 8, evaluations
