@@ -1,6 +1,7 @@
 """Wall time of a 10,000-scene sweep with the default integrator, and what each skip saves.
 
-  * the sweep: minimum of 3 runs after a warm-up, in this process;
+  * the sweep: minimum of 5 runs after a warm-up, in this process (the machine is shared:
+    single runs vary by ±20%);
   * the same sweep spread over a 2-process pool (one chunk per core): warm, and including
     the pool's start;
   * trajectories: the same sweep recording them (they are off unless asked for);
@@ -25,7 +26,7 @@ import plateimpact as pi
 from plateimpact.crater import crater_section
 
 
-def best_of(function, repeats=3):
+def best_of(function, repeats=5):
     function()  # warm-up
     times = []
     for _ in range(repeats):
