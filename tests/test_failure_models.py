@@ -62,12 +62,20 @@ def test_hinge_finger_at_normal_incidence_has_no_lift(integrator):
     lifted a normal impact sideways (lateral 4e-21 m). The full finger (β = 2α*) at θ = 0
     acts exactly along the path, so the path stays on the normal."""
     hinge = Hinge()
-    plate = pi.Plate("t", 18.3 * mm, np.exp(18.0), np.exp(4.0), 18.3 * mm, 10 * deg)
+    plate = pi.Plate(
+        "t",
+        18.3 * mm,
+        a=np.exp(18.0),
+        b=np.exp(4.0),
+        critical_penetration=18.3 * mm,
+        failure_angle=10 * deg,
+    )
     sphere = pi.Sphere(radius=np.exp(-4.0), mass=0.0282)
     batch = pi.Simulation.from_names(failure="hinge").model.bind(
         pi.SceneBatch.from_scenes([pi.Scene(sphere, plate, 403.0, 0.0)])
     )
-    _, incidence = hinge.finger(np.zeros(1), 2.0 * batch.failure_angle, batch)
+    view = batch.failure
+    _, incidence = hinge.finger(np.zeros(1), 2.0 * view.failure_angle, view)
     assert incidence[0] == 0.0
     simulation = pi.Simulation.from_names(failure="hinge", integrator=integrator)
     result = simulation.run(pi.Scene(sphere, plate, 403.0, 0.0), record_trajectory=True)

@@ -138,7 +138,7 @@ def test_damaged_archive_structure_gives_archive_error(archive_bytes, tmp_path):
     code, err = run_cli(["show", str(path)])
     assert code == 2 and len(err.strip().splitlines()) == 1 and "damaged" in err
     with pytest.raises(pi.ArchiveError):
-        pi.Archive(path).load()
+        pi.StudyResults.from_archive(path)
 
 
 def test_damaged_run_attributes_give_archive_error(archive_bytes, tmp_path):

@@ -99,28 +99,24 @@ def test_default_integrator_meets_its_accuracy_target(scenes, reference):
 
 
 @pytest.mark.parametrize("failure", ["plugging", "hinge"])
-def test_stepping_onto_branch_surfaces_cuts_rejections_and_error(failure, scenes):
-    """A step that straddles a surface where the force stops being smooth (the contact
-    geometry's branches, the hinge's θ1) is rejected again and again, and when one is
-    accepted its error exceeds its estimate. Stepping onto the surface first does better
-    on both counts (measured: 3× fewer rejections, 35× smaller errors)."""
+def test_stepping_across_or_onto_branch_surfaces_meets_the_targets(failure, scenes):
+    """Whether dopri5 steps onto the surfaces where the force stops being smooth (the
+    default) or across them, it reaches the reference's outcomes, and on them the
+    default's accuracy targets (what landing saves in steps and error is a benchmark:
+    benchmarks/branch_landing.py)."""
     reference = pi.Simulation.from_names(
         failure=failure, integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
     ).run_batch(scenes)
     speed = np.array([s.impact_speed for s in scenes])
     flying = reference.outcome != pi.Outcome.EMBEDMENT
-    runs = {}
-    for landing in (True, False):
+    for landing, rtol in ((True, 1e-8), (False, 1e-10)):
         result = pi.Simulation.from_names(
-            failure=failure, integrator_settings={"rtol": 1e-8, "branch_landing": landing}
+            failure=failure, integrator_settings={"rtol": rtol, "branch_landing": landing}
         ).run_batch(scenes)
         np.testing.assert_array_equal(result.outcome, reference.outcome)
-        speed_error = np.max(np.abs(result.exit_speed - reference.exit_speed) / speed)
-        turn_error = np.max(np.abs(result.exit_obliquity - reference.exit_obliquity)[flying])
-        runs[landing] = (result.stats["rejected_steps"], speed_error, turn_error)
-    (rejected, speed_error, turn_error), (rejected_off, speed_off, turn_off) = runs.values()
-    assert rejected < 0.5 * rejected_off, runs
-    assert speed_error < 0.2 * speed_off and turn_error < 0.2 * turn_off, runs
+        assert np.max(np.abs(result.exit_speed - reference.exit_speed) / speed) <= 1e-6
+        turn_error = np.abs(result.exit_obliquity - reference.exit_obliquity)[flying]
+        assert np.degrees(np.max(turn_error)) <= 1e-4
 
 
 @pytest.mark.parametrize("integrator", ["dopri5", "solve_ivp"])
@@ -198,41 +194,36 @@ def test_chunks_concatenate_to_the_whole():
     joined = pi.BatchResult.concat(parts)
     for name, column in whole.columns.items():
         np.testing.assert_array_equal(column, joined.columns[name], err_msg=name)
-    for name, column in whole.trajectory.items():
+    for name, column in whole.trajectory.values.items():
         np.testing.assert_array_equal(column, joined.trajectory[name], err_msg=name)
     assert joined.trajectory_of(45).time.size == whole.trajectory_of(45).time.size
 
 
-@pytest.mark.parametrize(("blur", "most"), [(0.0, 8), (1e-12, 10)])
-def test_event_root_finding_stops_within_a_few_iterations_on_the_event_side(blur, most):
+@pytest.mark.parametrize("blur", [0.0, 1e-12])
+def test_event_root_finding_ends_on_the_event_side_within_the_resolution(blur):
     """Event refinement on a cubic dense output, y(σ) = σ + 0.3σ² − 0.2σ³, for 200 levels:
-    the returned σ is on the event's side of the margin (>= 0), within the documented
-    resolution of the root, and reached in a handful of margin evaluations, also when the
-    margin wiggles by 1e-12 around its root, as a difference of larger lengths does at
-    rounding (there the iteration used to bounce from side to side: 13 evaluations
-    without the rounding-resolution stop, and up to the 16-step cap in the model)."""
-    from plateimpact_plugins.event_location import EVENT_SAMPLES, dense_state, locate
+    the returned σ is on the event's side of the margin (>= 0) and within the documented
+    resolution of the root, also when the margin wiggles by 1e-12 around its root, as a
+    difference of larger lengths does at rounding (how many evaluations that takes is a
+    benchmark: benchmarks/event_location.py)."""
+    from plateimpact.events import locate
 
     levels = np.random.default_rng(1).uniform(0.05, 1.0, 200)
     coefficients = np.zeros((3, 1, levels.size))
     coefficients[:, 0] = np.array([1.0, 0.3, -0.2])[:, np.newaxis]
-    start = np.zeros((1, levels.size))
-    calls = []
+    dense = pi.PolynomialDenseOutput(np.zeros((1, levels.size)), coefficients)
+    samples = np.linspace(0.0, 1.0, 5)
 
     def margin(state):
-        calls.append(1)
         return (state[0] - levels) + blur * np.sin(1e12 * state[0])
 
     def path(sigma):
         return sigma + 0.3 * sigma**2 - 0.2 * sigma**3
 
-    at_samples = path(EVENT_SAMPLES)[:, np.newaxis]
+    at_samples = path(samples)[:, np.newaxis]
     first = np.argmax((at_samples[:-1] < levels) & (at_samples[1:] >= levels), axis=0)
-    lo, hi = EVENT_SAMPLES[first], EVENT_SAMPLES[first + 1]
+    lo, hi = samples[first], samples[first + 1]
     f_lo, f_hi = margin(path(lo)[np.newaxis]), margin(path(hi)[np.newaxis])
-    calls.clear()
-    sigma = locate(margin, start, coefficients, lo, hi, f_lo, f_hi)
-    evaluations = len(calls)
-    assert np.all(margin(dense_state(start, coefficients, sigma)) >= 0.0)
+    sigma = locate(margin, dense, lo, hi, f_lo, f_hi)
+    assert np.all(margin(dense(sigma)) >= 0.0)
     assert np.max(np.abs(path(sigma) - levels)) < 1e-10
-    assert evaluations <= most, evaluations

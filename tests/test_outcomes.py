@@ -197,7 +197,7 @@ def test_a_process_pool_gives_the_serial_results_bit_for_bit(sphere):
         spread = simulation.run_batch(scenes, record_trajectory=True, executor=pool, chunk_size=7)
     for name, column in serial.columns.items():
         np.testing.assert_array_equal(spread.columns[name], column, err_msg=name)
-    for name, column in serial.trajectory.items():
+    for name, column in serial.trajectory.values.items():
         np.testing.assert_array_equal(spread.trajectory[name], column, err_msg=name)
     with pytest.raises(pi.ParameterError, match="chunk_size"):
         with ProcessPoolExecutor(1) as pool:

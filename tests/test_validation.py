@@ -16,6 +16,10 @@ PLATE = presets.plate("2024-T3/3.18")
 SPHERE = presets.DEFAULT_SPHERE
 
 
+def run(plate: pi.Plate) -> pi.Result:
+    return pi.Simulation.from_names().run(pi.Scene(SPHERE, plate, 300.0, 0.0))
+
+
 @pytest.mark.parametrize(
     ("build", "parameter", "allowed"),
     [
@@ -25,16 +29,25 @@ SPHERE = presets.DEFAULT_SPHERE
         (lambda: pi.Sphere(radius=math.nan, mass=1e-3), "radius", "> 0 mm"),
         (lambda: pi.Sphere.of_density(1 * mm, -5.0), "density", "> 0 kg/m^3"),
         (lambda: attrs.evolve(PLATE, thickness=0.0), "thickness", "> 0 mm"),
-        (lambda: attrs.evolve(PLATE, a=-1.0), "a", "> 0 N/m^2"),
-        (lambda: attrs.evolve(PLATE, b=-1.0), "b", ">= 0 kg/m^3"),
-        (lambda: attrs.evolve(PLATE, critical_penetration=0.0), "critical_penetration", "> 0 mm"),
+        (lambda: attrs.evolve(PLATE, a=math.nan), "a", "a must be a number"),
+        (lambda: attrs.evolve(PLATE, a="strong"), "a", "a must be a number"),
+        # A plate constant's range belongs to the plug-in that declares it: checked when a
+        # model reads the plate.
+        (lambda: run(attrs.evolve(PLATE, a=-1.0)), "a", "> 0 N/m^2"),
+        (lambda: run(attrs.evolve(PLATE, b=-1.0)), "b", ">= 0 kg/m^3"),
+        (lambda: run(attrs.evolve(PLATE, critical_penetration=0.0)), "critical_penetration", "> 0 mm"),
         (
-            lambda: attrs.evolve(PLATE, critical_penetration=-math.inf),
+            lambda: run(attrs.evolve(PLATE, critical_penetration=-math.inf)),
             "critical_penetration",
             "> 0 mm",
         ),
-        (lambda: attrs.evolve(PLATE, failure_angle=0.0), "failure_angle", "in (0, 90) deg"),
-        (lambda: attrs.evolve(PLATE, failure_angle=90 * deg), "failure_angle", "in (0, 90) deg"),
+        (lambda: run(attrs.evolve(PLATE, failure_angle=0.0)), "failure_angle", "in (0, 90) deg"),
+        (
+            lambda: run(attrs.evolve(PLATE, failure_angle=90 * deg)),
+            "failure_angle",
+            "in (0, 90) deg",
+        ),
+        (lambda: run(pi.Plate("bare", 3 * mm)), "a", "is needed by resistance 'poncelet'"),
         (lambda: pi.Scene(SPHERE, PLATE, 0.0, 0.0), "impact_speed", "> 0 m/s"),
         (lambda: pi.Scene(SPHERE, PLATE, math.inf, 0.0), "impact_speed", "> 0 m/s"),
         (lambda: pi.Scene(SPHERE, PLATE, 100.0, 90 * deg), "impact_obliquity", "in [0, 90) deg"),

@@ -9,7 +9,7 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version
 
 from . import geometry, presets, units
-from .archive import Archive
+from .storage.archive import Archive
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
 from .calibration import (
@@ -22,6 +22,9 @@ from .calibration import (
     fit_dri,
     newton_fit,
 )
+from .binding import BoundBatch
+from .dense import DenseOutput, PolynomialDenseOutput, hermite
+from .dynamics import Dynamics
 from .errors import (
     ArchiveError,
     CalibrationError,
@@ -30,13 +33,16 @@ from .errors import (
     ParameterError,
     PlateFileError,
     PlateImpactError,
+    PluginError,
     ShotDataError,
     UnknownNameError,
 )
 from .failure import FailureModel
 from .geometry import contact_geometry, contact_lost_margin, force_inclination
 from .hookspecs import hookimpl
-from .integrator import Integrator, ResultRecorder
+from .integrator import MAX_STEPS, RTOL, Integrator, Step, StepControl, StepperState
+from .parameters import Parameter, Range
+from .plugin import Column
 from .model import (
     AT_REST,
     CONTACT_LOST,
@@ -52,14 +58,15 @@ from .model import (
     TURNED_BACK,
     ImpactModel,
 )
-from .plate_file import load_plate_file, save_plate_file
+from .storage.plate_file import load_plate_file, save_plate_file
 from .registry import PluginRegistry, default_registry, load_registry
-from .resistance import ResistanceLaw, contact_force
+from .resistance import BoundResistance, ResistanceLaw, contact_force
 from .results import BatchResult, Outcome, Result, Trajectory
 from .scene import Scene
-from .shots import Shots, synthetic_shots
+from .storage.shots import Shots, synthetic_shots
 from .simulation import Simulation, run
-from .study import Comparison, Study, StudyResults, Variant
+from .study import Comparison, Study, StudyResults
+from .variant import Variant
 
 try:
     __version__ = version("plateimpact")
@@ -73,10 +80,12 @@ __all__ = [
     "EVENT_OUTCOMES",
     "KINEMATIC_STATE",
     "LATERAL",
+    "MAX_STEPS",
     "OBLIQUITY",
     "ONSET",
     "PENETRATION",
     "PERFORATED",
+    "RTOL",
     "SPEED",
     "TURNED_BACK",
     "Archive",
@@ -85,27 +94,38 @@ __all__ = [
     "CalibrationReport",
     "ConvergenceError",
     "BatchResult",
+    "BoundBatch",
+    "BoundResistance",
     "Calibration",
+    "Column",
     "Comparison",
+    "DenseOutput",
     "DriFit",
+    "Dynamics",
     "FailureModel",
     "ImpactModel",
     "IntegrationError",
     "Integrator",
     "Outcome",
+    "Parameter",
     "ParameterError",
     "Plate",
     "PlateFileError",
     "PlateImpactError",
+    "PluginError",
     "PluginRegistry",
+    "PolynomialDenseOutput",
+    "Range",
     "ResistanceLaw",
     "Result",
-    "ResultRecorder",
     "Scene",
     "SceneBatch",
     "ShotDataError",
     "Shots",
     "Simulation",
+    "Step",
+    "StepControl",
+    "StepperState",
     "Study",
     "StudyResults",
     "Sphere",
@@ -122,6 +142,7 @@ __all__ = [
     "fit_dri",
     "force_inclination",
     "geometry",
+    "hermite",
     "hookimpl",
     "load_plate_file",
     "load_registry",

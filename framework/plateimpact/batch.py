@@ -10,73 +10,90 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
-from . import validation as v
-from .bodies import Plate, Sphere
-from .scene import Scene
+from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from .errors import ParameterError
+from .parameters import Parameter
+from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 
-#: The columns every batch has, with their range [SI units].
-BASE_COLUMNS: dict[str, v.Range] = {
-    "radius": v.RADIUS,  # Rs [m]
-    "mass": v.MASS,  # m [kg]
-    "thickness": v.THICKNESS,  # T [m]
-    "a": v.STRENGTH_A,  # [N/m²]
-    "b": v.DENSITY_B,  # [kg/m³]
-    "critical_penetration": v.CRITICAL_PENETRATION,  # P* of the plate [m]
-    "failure_angle": v.FAILURE_ANGLE,  # α* [rad]
-    "impact_speed": v.IMPACT_SPEED,  # Vs [m/s]
-    "impact_obliquity": v.IMPACT_OBLIQUITY,  # θs [rad]
+#: The columns every batch has, whatever the model: the sphere, the plate's thickness
+#: and the impact. Any other column is a plate constant (``a``, ``critical_penetration``,
+#: ...), whose facts belong to the plug-in that declares it.
+CORE_COLUMNS: dict[str, Parameter] = {
+    p.name: p for p in (RADIUS, MASS, THICKNESS, IMPACT_SPEED, IMPACT_OBLIQUITY)
 }
 
 
 class SceneBatch:
     """Per-scene parameters as 1-D float arrays of equal length.
 
-    Columns are read as attributes (``batch.radius``). Besides :data:`BASE_COLUMNS`, a
-    model adds the columns its plug-ins prepare once per batch (``onset_penetration``,
-    ``failure_plane_depth``, ...), so that no derived quantity is recomputed per step.
+    Columns are read as attributes (``batch.radius``): :data:`CORE_COLUMNS`, then the
+    plate constants. Inside the step loop a plug-in sees its own view of the bound batch
+    (:class:`~plateimpact.binding.BoundBatch`): the core columns, the plate constants it
+    declared and the per-scene columns it prepared.
     """
 
     __slots__ = ("_columns", "size")
 
-    def __init__(self, columns: Mapping[str, np.ndarray], *, validate: bool = True) -> None:
+    _columns: dict[str, np.ndarray]
+    size: int
+
+    def __init__(self, columns: Mapping[str, object], *, validate: bool = True) -> None:
         arrays = {k: np.ascontiguousarray(c, dtype=float).reshape(-1) for k, c in columns.items()}
         sizes = {a.size for a in arrays.values()}
         if len(sizes) > 1:
-            raise ValueError(f"batch columns differ in length: {sorted(sizes)}")
+            raise ParameterError("columns", f"batch columns differ in length: {sorted(sizes)}")
         if validate:
-            for name, allowed in BASE_COLUMNS.items():
+            for name, declared in CORE_COLUMNS.items():
                 if name not in arrays:
-                    raise ValueError(f"batch column {name!r} is missing")
-                allowed.check(name, arrays[name])
+                    raise ParameterError(name, f"batch column {name!r} is missing")
+                declared.check(arrays[name])
+            for name, values in arrays.items():
+                if name not in CORE_COLUMNS and np.isnan(values).any():
+                    scene = int(np.flatnonzero(np.isnan(values))[0])
+                    raise ParameterError(name, f"{name} must be a number, got nan (scene {scene})")
         self._columns = arrays
         self.size = sizes.pop() if sizes else 0
 
     @classmethod
+    def of(cls, columns: dict[str, np.ndarray], size: int) -> SceneBatch:
+        """A batch of arrays already checked (no copy, no validation): for the core's own
+        views and subsets."""
+        new = object.__new__(cls)
+        new._columns = columns
+        new.size = size
+        return new
+
+    @classmethod
     def from_scenes(cls, scenes: Iterable[Scene]) -> SceneBatch:
-        """Columns from validated :class:`Scene` objects."""
+        """Columns from validated :class:`Scene` objects, whose plates must have the same
+        constants."""
         scenes = list(scenes)
-        return cls(
-            {
-                "radius": [s.sphere.radius for s in scenes],
-                "mass": [s.sphere.mass for s in scenes],
-                "thickness": [s.plate.thickness for s in scenes],
-                "a": [s.plate.a for s in scenes],
-                "b": [s.plate.b for s in scenes],
-                "critical_penetration": [s.plate.critical_penetration for s in scenes],
-                "failure_angle": [s.plate.failure_angle for s in scenes],
-                "impact_speed": [s.impact_speed for s in scenes],
-                "impact_obliquity": [s.impact_obliquity for s in scenes],
-            },
-            validate=False,
-        )
+        names = [tuple(k for k, _ in s.plate.constants) for s in scenes]
+        for i, found in enumerate(names):
+            if found != names[0]:
+                raise ParameterError(
+                    "constants",
+                    f"the plates of a batch must have the same constants: scene {i} has "
+                    f"{', '.join(found) or 'none'}, scene 0 has {', '.join(names[0]) or 'none'}",
+                )
+        columns: dict[str, list[float]] = {
+            "radius": [s.sphere.radius for s in scenes],
+            "mass": [s.sphere.mass for s in scenes],
+            "thickness": [s.plate.thickness for s in scenes],
+            "impact_speed": [s.impact_speed for s in scenes],
+            "impact_obliquity": [s.impact_obliquity for s in scenes],
+        }
+        for k, name in enumerate(names[0] if scenes else ()):
+            columns[name] = [s.plate.constants[k][1] for s in scenes]
+        return cls(columns, validate=False)
 
     @classmethod
     def grid(
         cls,
         sphere: Sphere,
         plate: Plate,
-        speeds: np.ndarray,
-        obliquities: np.ndarray,
+        speeds: np.ndarray | Iterable[float],
+        obliquities: np.ndarray | Iterable[float],
     ) -> SceneBatch:
         """Every (obliquity, speed) pair for one sphere and plate, obliquity-major.
 
@@ -85,38 +102,36 @@ class SceneBatch:
         """
         speeds = np.asarray(speeds, dtype=float).reshape(-1)
         obliquities = np.asarray(obliquities, dtype=float).reshape(-1)
-        v.IMPACT_SPEED.check("impact_speed", speeds)
-        v.IMPACT_OBLIQUITY.check("impact_obliquity", obliquities)
+        IMPACT_SPEED.check(speeds)
+        IMPACT_OBLIQUITY.check(obliquities)
         obl, spd = np.meshgrid(obliquities, speeds, indexing="ij")
         n = spd.size
-        return cls(
-            {
-                "radius": np.full(n, sphere.radius),
-                "mass": np.full(n, sphere.mass),
-                "thickness": np.full(n, plate.thickness),
-                "a": np.full(n, plate.a),
-                "b": np.full(n, plate.b),
-                "critical_penetration": np.full(n, plate.critical_penetration),
-                "failure_angle": np.full(n, plate.failure_angle),
-                "impact_speed": spd.ravel(),
-                "impact_obliquity": obl.ravel(),
-            },
-            validate=False,
-        )
+        columns = {
+            "radius": np.full(n, sphere.radius),
+            "mass": np.full(n, sphere.mass),
+            "thickness": np.full(n, plate.thickness),
+            "impact_speed": spd.ravel(),
+            "impact_obliquity": obl.ravel(),
+        }
+        columns.update({name: np.full(n, value) for name, value in plate.constants})
+        return cls.of(columns, n)
 
     @classmethod
     def concat(cls, batches: Iterable[SceneBatch]) -> SceneBatch:
         """One batch holding the scenes of ``batches`` in order (same columns required)."""
         batches = list(batches)
-        names = set(batches[0]._columns) if batches else set(BASE_COLUMNS)
-        if any(set(b._columns) != names for b in batches):
-            raise ValueError("batches to concatenate must have the same columns")
-        return cls(
-            {k: np.concatenate([b._columns[k] for b in batches]) for k in names}
-            if batches
-            else {k: np.zeros(0) for k in names},
-            validate=False,
-        )
+        names = list(batches[0]._columns) if batches else list(CORE_COLUMNS)
+        for batch in batches:
+            if set(batch._columns) != set(names):
+                raise ParameterError(
+                    "columns",
+                    "batches to concatenate must have the same columns, got "
+                    f"{', '.join(sorted(batch._columns))} and {', '.join(sorted(names))}",
+                )
+        columns = {k: np.concatenate([b._columns[k] for b in batches]) for k in names}
+        if not batches:
+            columns = {k: np.zeros(0) for k in names}
+        return cls.of(columns, sum(b.size for b in batches))
 
     def __getattr__(self, name: str) -> np.ndarray:
         if name.startswith("_"):  # e.g. _columns itself while unpickling: not a column
@@ -124,17 +139,31 @@ class SceneBatch:
         try:
             return self._columns[name]
         except KeyError:
-            raise AttributeError(f"SceneBatch has no column {name!r}") from None
+            raise AttributeError(
+                f"this batch has no column {name!r} (columns: {', '.join(self._columns)}); "
+                "a plug-in sees only the plate constants it declares in plate_constants"
+            ) from None
+
+    def __getstate__(self) -> tuple[dict[str, np.ndarray], int]:
+        return self._columns, self.size
+
+    def __setstate__(self, state: tuple[dict[str, np.ndarray], int]) -> None:
+        self._columns, self.size = state
 
     def __len__(self) -> int:
         return self.size
 
     @property
-    def columns(self) -> Mapping[str, np.ndarray]:
-        """Read-only view of the columns."""
+    def columns(self) -> dict[str, np.ndarray]:
+        """The columns by name (a new dict; the arrays are shared)."""
         return dict(self._columns)
 
-    def with_columns(self, **extra: np.ndarray) -> SceneBatch:
+    @property
+    def constant_names(self) -> list[str]:
+        """The plate constants among the columns."""
+        return [name for name in self._columns if name not in CORE_COLUMNS]
+
+    def with_columns(self, **extra: object) -> SceneBatch:
         """A batch with more (or replaced) columns, each broadcast to the batch size."""
         merged = dict(self._columns)
         for name, values in extra.items():
@@ -143,7 +172,6 @@ class SceneBatch:
 
     def take(self, index: np.ndarray) -> SceneBatch:
         """The sub-batch of the scenes at ``index`` (integer or boolean array)."""
-        new = object.__new__(SceneBatch)
-        new._columns = {k: c[index] for k, c in self._columns.items()}
-        new.size = next(iter(new._columns.values())).size if new._columns else 0
-        return new
+        columns = {k: c[index] for k, c in self._columns.items()}
+        size = next(iter(columns.values())).size if columns else 0
+        return SceneBatch.of(columns, size)

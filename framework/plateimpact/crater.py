@@ -21,44 +21,15 @@ perforation's crater is holed where the sphere went through).
 
 from __future__ import annotations
 
-import attrs
 import numpy as np
 
-from .results import BatchResult, Trajectory
+from .ragged import Ragged
+from .results import BatchResult, CraterSection, Trajectory
 
 #: Grid of lateral positions for the floor [points].
 DEFAULT_RESOLUTION = 1500
 #: Largest spacing of the circles kept from the trajectory, as a fraction of Rs.
 CIRCLE_SPACING = 1.0 / 400.0
-
-
-@attrs.frozen(eq=False)
-class CraterSection:
-    """The crater floor in the plane of motion, from entry to exit.
-
-    Attributes
-    ----------
-    lateral : ndarray
-        Distance along the plate from the crater's entry point [m]; starts at 0.
-    depth : ndarray
-        Depth of the floor below the front surface [m], >= 0; starts at 0.
-    impact_point : float
-        Lateral position of the first-contact point in these coordinates [m].
-    """
-
-    lateral: np.ndarray
-    depth: np.ndarray
-    impact_point: float
-
-    @property
-    def length(self) -> float:
-        """Crater length along the plate [m]."""
-        return float(self.lateral[-1] - self.lateral[0])
-
-    @property
-    def max_depth(self) -> float:
-        """Deepest point of the floor [m]."""
-        return float(self.depth.max())
 
 
 def _kept_circles(
@@ -135,74 +106,22 @@ def _surface_crossing(grid: np.ndarray, floor: np.ndarray, outside: int, inside:
     return float(grid[inside] + fraction * (grid[outside] - grid[inside]))
 
 
-@attrs.frozen(eq=False)
-class CraterSections:
-    """The crater sections of a batch as a contiguous ragged array (CF conventions).
-
-    Scene ``i`` owns ``lateral[offsets[i]:offsets[i + 1]]`` and the same slice of
-    ``depth``, with ``offsets`` the running sum of ``counts``.
-
-    Attributes
-    ----------
-    lateral : ndarray
-        Distance along the plate from each crater's entry point [m], concatenated.
-    depth : ndarray
-        Depth of the floor below the front surface [m], concatenated.
-    counts : ndarray
-        Points per scene [1].
-    impact_point : ndarray
-        Lateral position of each scene's first-contact point [m].
-    """
-
-    lateral: np.ndarray
-    depth: np.ndarray
-    counts: np.ndarray
-    impact_point: np.ndarray
-
-    @classmethod
-    def from_result(
-        cls, result: BatchResult, radius: np.ndarray, thickness: np.ndarray
-    ) -> CraterSections:
-        """Sections of every scene of ``result`` (recorded with its trajectories) for
-        sphere radii ``radius`` [m] and plate thicknesses ``thickness`` [m], per scene."""
-        if result.trajectory is None:
-            raise ValueError("crater sections need trajectories: run with record_trajectory")
-        radius, thickness = np.broadcast_arrays(radius, thickness, np.zeros(len(result)))[:2]
-        sections = [
-            crater_section(result.trajectory_of(i), float(radius[i]), thickness=float(thickness[i]))
-            for i in range(len(result))
-        ]
-        return cls.from_sections(sections)
-
-    @classmethod
-    def from_sections(cls, sections: list[CraterSection]) -> CraterSections:
-        """Pack single sections in order."""
-        return cls(
-            np.concatenate([s.lateral for s in sections]) if sections else np.zeros(0),
-            np.concatenate([s.depth for s in sections]) if sections else np.zeros(0),
-            np.array([s.lateral.size for s in sections], dtype=np.int64),
-            np.array([s.impact_point for s in sections], dtype=float),
-        )
-
-    @classmethod
-    def concat(cls, parts: list[CraterSections]) -> CraterSections:
-        """One ragged array holding ``parts`` in order."""
-        return cls(
-            *(np.concatenate([getattr(p, k) for p in parts]) for k in attrs.fields_dict(cls))
-        )
-
-    @property
-    def offsets(self) -> np.ndarray:
-        return np.concatenate([[0], np.cumsum(self.counts)])
-
-    def __len__(self) -> int:
-        return self.counts.size
-
-    def section(self, i: int) -> CraterSection:
-        """The section of scene ``i``."""
-        lo, hi = self.offsets[i], self.offsets[i + 1]
-        return CraterSection(self.lateral[lo:hi], self.depth[lo:hi], float(self.impact_point[i]))
-
-    def take(self, index: np.ndarray) -> CraterSections:
-        """The sections of scenes ``index`` (integer array), in that order."""
-        return CraterSections.from_sections([self.section(int(i)) for i in index])
+def crater_sections(
+    result: BatchResult, radius: np.ndarray, thickness: np.ndarray
+) -> Ragged:
+    """The sections of every scene of ``result`` (recorded with its trajectories) for
+    sphere radii ``radius`` [m] and plate thicknesses ``thickness`` [m], per scene: a
+    ragged array with ``lateral`` and ``depth`` per point and ``impact_point`` per scene
+    (as :meth:`BatchResult.crater_of` reads it)."""
+    if result.trajectory is None:
+        raise ValueError("crater sections need trajectories: run with record_trajectory")
+    radius, thickness = np.broadcast_arrays(radius, thickness, np.zeros(len(result)))[:2]
+    sections = []
+    for i in range(len(result)):
+        path = result.trajectory_of(i)
+        assert path is not None
+        sections.append(crater_section(path, float(radius[i]), thickness=float(thickness[i])))
+    return Ragged.from_rows(
+        [{"lateral": s.lateral, "depth": s.depth} for s in sections],
+        {"impact_point": [s.impact_point for s in sections]},
+    )

@@ -55,3 +55,9 @@ class CalibrationError(PlateImpactError, RuntimeError):
 
 class ConvergenceError(CalibrationError):
     """The report's Newton iteration (eqs 44–49) did not converge within its iterations."""
+
+
+class PluginError(PlateImpactError):
+    """A plug-in is malformed or two plug-ins conflict: an undeclared or missing prepared
+    column, two declarations of one plate constant that disagree, a class that cannot be
+    registered. The message names the plug-ins."""

@@ -8,10 +8,11 @@ from typing import ClassVar
 import numpy as np
 
 from .batch import SceneBatch
-from .resistance import ResistanceLaw
+from .plugin import Plugin
+from .resistance import BoundResistance
 
 
-class FailureModel(ABC):
+class FailureModel(Plugin, ABC):
     """When the plate fails, and how the force on the sphere changes once it has.
 
     The core calls the methods below with arrays over the scenes of a batch:
@@ -24,9 +25,13 @@ class FailureModel(ABC):
     * :meth:`perforation_margin`, likewise only for failed scenes: >= 0 once the sphere
       has passed the material that still resists, which ends the impact in perforation.
 
-    Subclass, set ``name``, implement the three methods in numpy, and register the class
-    from a ``plateimpact_register`` hook. Per-scene constants that do not change during
-    the impact belong in :meth:`prepare`, which runs once per batch.
+    Subclass, set ``name``, declare the plate constants it reads (``plate_constants``) and
+    the columns it prepares (``columns``), implement the three methods in numpy, and
+    register the class from a ``plateimpact_register`` hook. Per-scene constants that do
+    not change during the impact belong in :meth:`prepare`, which runs once per batch.
+    ``batch`` arguments are this model's view of the scenes (core columns, its plate
+    constants, its prepared columns); ``law`` is the model's resistance law on its own
+    view (:class:`~plateimpact.resistance.BoundResistance`).
 
     **Failure state.** A model whose failure evolves (the hinge's finger angle β) names
     its variables in ``state_names``; the integrator then carries them per scene as an
@@ -35,15 +40,14 @@ class FailureModel(ABC):
     restricted to the failed scenes; stateless models get shape ``(0, n)`` and ignore it.
     """
 
-    name: ClassVar[str]
-    version: ClassVar[str] = "1"
     #: Names of the variables this model integrates after failure (default: none).
     state_names: ClassVar[tuple[str, ...]] = ()
     #: Their units, for archives (e.g. ``("rad",)``).
     state_units: ClassVar[tuple[str, ...]] = ()
 
     def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
-        """Per-scene columns to compute once per batch (default none)."""
+        """The per-scene columns declared in ``columns``, computed once per batch (default
+        none)."""
         return {}
 
     @abstractmethod
@@ -58,9 +62,11 @@ class FailureModel(ABC):
         speed: np.ndarray,
         state: np.ndarray,
         batch: SceneBatch,
-        law: ResistanceLaw,
+        law: BoundResistance,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Drag and lift [N] that failure adds to the intact force (negative: relief)."""
+        """Drag and lift [N] that failure adds to the intact force (negative: relief);
+        ``law.contact_force(P − h, θ, V)`` is the force on the part of the contact surface
+        beyond a plane at depth h (eqs 9–14)."""
 
     @abstractmethod
     def perforation_margin(
@@ -110,7 +116,3 @@ class FailureModel(ABC):
         ``obliquity_rate`` is dθ/dt [rad/s] from the net force, failure included.
         """
         return np.zeros_like(state)
-
-    def settings(self) -> dict[str, object]:
-        """The plug-in's settings, for archives (default: none)."""
-        return {}

@@ -19,18 +19,22 @@ being integrated. Real work is done by the registered classes' methods.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import pluggy
-
-if TYPE_CHECKING:
-    from .registry import PluginRegistry
 
 PROJECT = "plateimpact"
 hookspec = pluggy.HookspecMarker(PROJECT)
 hookimpl = pluggy.HookimplMarker(PROJECT)
 
 
+class Registrar(Protocol):
+    """What the hook is given: something that takes plug-in classes
+    (:class:`plateimpact.PluginRegistry`)."""
+
+    def add(self, cls: type) -> None: ...
+
+
 @hookspec
-def plateimpact_register(registry: PluginRegistry) -> None:
+def plateimpact_register(registry: Registrar) -> None:
     """Add this package's ResistanceLaw, FailureModel and Integrator classes to ``registry``."""

@@ -1,139 +1,122 @@
-"""The Integrator interface and the recorder integrators fill their results with."""
+"""The Integrator interface: a stepper that the core driver runs.
+
+The driver (:mod:`plateimpact.driver`) owns everything integrators share: binding the
+batch, the events and their order, failure onset, the θ = π hold, rest, recording,
+dropping finished scenes, step-size control. An integrator supplies only what is its
+own: its first step, one step of the active scenes (with its error estimate, if it has
+one) and a dense output on which the driver locates events.
+"""
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
-from .batch import SceneBatch
-from .model import ImpactModel
-from .results import RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
+from .dense import DenseOutput
+from .dynamics import Dynamics
+from .parameters import Parameter, Range
+from .plugin import Plugin
+
+#: Per-scene arrays a stepper carries from one accepted step to the next (last axis:
+#: scenes). ``derivative`` (d, n), if present, is f(y) at the current state, which the
+#: driver then uses instead of evaluating it again (branch prediction).
+StepperState = dict[str, np.ndarray]
+
+MAX_STEPS = Parameter(
+    "max_steps",
+    "give up (IntegrationError) when a scene has not finished after this many steps",
+    kind=int,
+    range=Range(1.0),
+    default=200_000,
+)
+RTOL = Parameter(
+    "rtol",
+    "local error tolerance relative to each component's scale (Rs, 1 rad, Vs)",
+    range=Range(1e-14, 1e-2),
+    default=1e-8,
+    flag="--rtol",
+)
 
 
-class Integrator(ABC):
-    """Advances a batch of scenes from first contact to their outcomes.
+class StepControl(NamedTuple):
+    """How the driver controls an adaptive integrator's steps.
 
-    :meth:`run` is the template: it binds the model to the batch (every per-scene
-    constant computed once), then calls :meth:`_integrate`, which a subclass implements.
-    The state of a scene is its penetration P [m], lateral displacement Y [m], obliquity
-    θ [rad] and speed V [m/s], starting at (0, 0, θs, Vs); the equations of motion are
-    dV/dt = −drag/m, dθ/dt = lift/(m V), dP/dt = V cos θ, dY/dt = V sin θ (eqs 25–30),
-    with drag and lift from :meth:`ImpactModel.forces`.
-
-    An integrator must honour the model's events: failure onset when P reaches
-    ``batch.onset_penetration``; the outcome tests of :meth:`ImpactModel.classify`;
-    rest when V reaches ``batch.rest_speed``; θ held at :attr:`ImpactModel.MAX_OBLIQUITY`.
-    It must work on whole arrays (no Python loop over scenes) and may drop finished
-    scenes from its working set. It reports through a :class:`ResultRecorder`.
+    ``rtol``: local error per step relative to each component's scale; ``error_order``:
+    the step follows err^(−1/error_order); ``branch_landing``: step onto the surfaces
+    where the force stops being smooth instead of across them (docs/integrators.md).
     """
 
-    name: ClassVar[str]
-    version: ClassVar[str] = "1"
+    rtol: float
+    error_order: int
+    branch_landing: bool = True
 
-    def run(
-        self, model: ImpactModel, batch: SceneBatch, *, record_trajectory: bool = False
-    ) -> BatchResult:
-        """Integrate every scene of ``batch`` to its outcome."""
-        recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
-        if batch.size:
-            self._integrate(model, model.bind(batch), recorder)
-        return recorder.result()
+
+class Step(NamedTuple):
+    """One step of every active scene.
+
+    ``y`` (d, n): states at t + h; ``h`` (n,): the step taken [s]; ``error`` (d, n): the
+    local error estimate, or None (no error control: fixed steps, or a solver that
+    controls its own); ``dense``: the states inside the step; ``state``: what to carry
+    to the next step where this one is accepted.
+    """
+
+    y: np.ndarray
+    h: np.ndarray
+    error: np.ndarray | None
+    dense: DenseOutput
+    state: StepperState
+
+
+class Integrator(Plugin, ABC):
+    """Advances a batch of scenes one step at a time; the driver does the rest.
+
+    The state of a scene is its penetration P [m], lateral displacement Y [m], obliquity
+    θ [rad] and speed V [m/s], then the failure model's state; ``dynamics.rates(y)`` is
+    dy/dt (eqs 25–30). Steps work on whole arrays: no Python loop over scenes.
+
+    Subclass, set ``name``, declare settings as attrs fields, and implement
+    :meth:`initial_step` and :meth:`advance`; override :meth:`start`, :meth:`restart` and
+    :meth:`step_control` as needed.
+    """
+
+    #: Give up after this many steps (a setting in the built-ins).
+    max_steps: int = 200_000
+    #: Equally spaced samples per step, ends included, at which the driver looks for
+    #: events and records the trajectory: more for long steps, 2 for very short ones.
+    event_samples: ClassVar[int] = 5
+
+    def step_control(self) -> StepControl | None:
+        """Error control for this run; None: every finite step is accepted and ``h``
+        stays at its initial value (default)."""
+        return None
 
     @abstractmethod
-    def _integrate(self, model: ImpactModel, batch: SceneBatch, recorder: ResultRecorder) -> None:
-        """Integrate the (bound) batch, reporting through ``recorder``."""
+    def initial_step(self, dynamics: Dynamics) -> np.ndarray:
+        """The first step of every scene [s] (``dynamics.time_scale`` is Rs/Vs)."""
 
-    def settings(self) -> dict[str, object]:
-        """The integrator's settings, for output and archives (default: none)."""
+    def start(self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray) -> StepperState:
+        """What the stepper carries between steps, at the initial state (default none)."""
         return {}
 
+    @abstractmethod
+    def advance(
+        self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray, h: np.ndarray, state: StepperState
+    ) -> Step:
+        """One step of length ``h`` [s] of every scene from (t, y)."""
 
-class ResultRecorder:
-    """Collects per-scene results and trajectory samples as an integrator produces them.
-
-    Scenes are addressed by their index in the original batch, so an integrator can
-    shrink its working arrays as scenes finish.
-    """
-
-    def __init__(
-        self, size: int, record_trajectory: bool, failure_state_names: tuple[str, ...] = ()
-    ) -> None:
-        self.size = size
-        self.record_trajectory = record_trajectory
-        self.failure_state_names = failure_state_names
-        self.columns: dict[str, np.ndarray] = {
-            name: np.full(size, np.nan) for name in RESULT_FIELDS
-        }
-        self.columns["outcome"] = np.zeros(size, dtype=np.int8)
-        self.columns["plate_failed"] = np.zeros(size, dtype=bool)
-        self._samples: list[tuple[np.ndarray, ...]] = []
-        self.stats: dict[str, float] = {"steps": 0, "force_evaluations": 0}
-
-    def sample(
+    def restart(
         self,
-        scene: np.ndarray,
-        time: np.ndarray,
-        penetration: np.ndarray,
-        lateral: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        failure_state: np.ndarray | None = None,
-        failed: np.ndarray | None = None,
-    ) -> None:
-        """Record the state of ``scene`` s if trajectories were asked for.
-
-        ``failure_state`` has shape (len(failure_state_names), n); where ``failed`` is
-        False it means nothing and is recorded as NaN.
-        """
-        if not self.record_trajectory:
-            return
-        columns = [time, penetration, lateral, obliquity, speed]
-        if self.failure_state_names:
-            mask = np.ones(np.shape(time), bool) if failed is None else failed
-            columns.extend(np.where(mask, failure_state, np.nan))
-        self._samples.append((scene.copy(), *(np.array(c, dtype=float) for c in columns)))
-
-    def failed(
-        self, scene: np.ndarray, time: np.ndarray, penetration: np.ndarray, lateral: np.ndarray
-    ) -> None:
-        """Record where and when the plate of ``scene`` failed."""
-        self.columns["plate_failed"][scene] = True
-        self.columns["failure_time"][scene] = time
-        self.columns["failure_penetration"][scene] = penetration
-        self.columns["failure_lateral"][scene] = lateral
-
-    def finish(
-        self,
-        scene: np.ndarray,
-        outcome: np.ndarray,
-        exit_speed: np.ndarray,
-        exit_obliquity: np.ndarray,
-        contact_time: np.ndarray,
-        max_penetration: np.ndarray,
-    ) -> None:
-        """Record the outcome of the finished ``scene`` s. The exit obliquity is the angle
-        from the plate normal, >= 0 (a path that ends just across the normal, θ < 0, is
-        the mirror image of one that does not)."""
-        c = self.columns
-        c["outcome"][scene] = outcome
-        c["exit_speed"][scene] = exit_speed
-        c["exit_obliquity"][scene] = np.abs(exit_obliquity)
-        c["contact_time"][scene] = contact_time
-        c["max_penetration"][scene] = max_penetration
-
-    def result(self) -> BatchResult:
-        """The batch's results; trajectories as contiguous ragged arrays."""
-        trajectory = counts = None
-        if self.record_trajectory:
-            names = [*TRAJECTORY_FIELDS, *(f"failure_{n}" for n in self.failure_state_names)]
-            if self._samples:
-                stacked = [np.concatenate(part) for part in zip(*self._samples, strict=True)]
-            else:
-                stacked = [np.zeros(0, dtype=int)] + [np.zeros(0)] * len(names)
-            scene, *values = stacked
-            order = np.lexsort((values[0], scene))  # by scene, then by time
-            trajectory = {k: x[order] for k, x in zip(names, values, strict=True)}
-            counts = np.bincount(scene, minlength=self.size)
-        return BatchResult(dict(self.columns), trajectory, counts, dict(self.stats))
+        dynamics: Dynamics,
+        t: np.ndarray,
+        y: np.ndarray,
+        state: StepperState,
+        index: np.ndarray,
+    ) -> StepperState:
+        """The carried state after the driver changed the scenes at ``index``: failure
+        onset, the 180° hold (new right-hand side, new y). Default: ``start`` there."""
+        fresh = self.start(dynamics.take(index), t[index], y[:, index])
+        for key, values in fresh.items():
+            state[key][..., index] = values
+        return state

@@ -2,19 +2,36 @@
 
 from __future__ import annotations
 
-from typing import ClassVar
+from collections.abc import Iterator
+from typing import Any, ClassVar
 
 import attrs
 import numpy as np
 
-from . import validation as v
-from .batch import SceneBatch
+from .batch import CORE_COLUMNS, SceneBatch
+from .binding import SLOTS, BoundBatch
+from .errors import ParameterError, PluginError
 from .failure import FailureModel
 from .geometry import branch_margins, contact_lost_margin
-from .resistance import ResistanceLaw, contact_force
+from .parameters import Parameter, Range
+from .plugin import Plugin
+from .resistance import BoundResistance, ResistanceLaw, contact_force
 from .results import Outcome
 
-REST_SPEED_FRACTION = v.Range(0.0, 1.0, True, True)
+REST_SPEED_FRACTION = Parameter(
+    "rest_speed_fraction",
+    "a sphere is at rest when its speed falls to this fraction of its impact speed",
+    range=Range(0.0, 1.0, True, True),
+    default=1e-2,
+)
+ONSET_PENETRATION = Parameter(
+    "onset_penetration",
+    "penetration at which the plate fails (the failure model's; inf: never)",
+    "m",
+    Range(0.0, low_open=True, allow_inf=True),
+    "mm",
+    1e-3,
+)
 
 #: Rows of the state vector y used by ODE integrators: P [m], Y [m], θ [rad], V [m/s],
 #: then the failure model's state variables.
@@ -48,7 +65,7 @@ class ImpactModel:
 
     resistance: ResistanceLaw = attrs.field(validator=attrs.validators.instance_of(ResistanceLaw))
     failure: FailureModel = attrs.field(validator=attrs.validators.instance_of(FailureModel))
-    rest_speed_fraction: float = REST_SPEED_FRACTION.field(default=1e-2)
+    rest_speed_fraction: float = REST_SPEED_FRACTION.field()
 
     #: Obliquity is held here once reached (model-notes §4): straight back out [rad].
     MAX_OBLIQUITY: ClassVar[float] = np.pi
@@ -57,17 +74,50 @@ class ImpactModel:
     #: "θ = π").
     TURN_BACK_TOLERANCE: ClassVar[float] = 1e-8
 
-    def bind(self, batch: SceneBatch) -> SceneBatch:
-        """The batch with every per-scene constant the step loop needs, computed once:
-        ``onset_penetration`` [m], ``rest_speed`` [m/s] and the plug-ins' own columns."""
-        extra = {**self.resistance.prepare(batch), **self.failure.prepare(batch)}
-        onset = np.asarray(self.failure.onset_penetration(batch), dtype=float)
-        v.CRITICAL_PENETRATION.check("onset_penetration", onset)
-        return batch.with_columns(
-            onset_penetration=onset,
-            rest_speed=self.rest_speed_fraction * batch.impact_speed,
-            **extra,
+    def __attrs_post_init__(self) -> None:
+        check_declarations(dict(self.plugins()))
+
+    def plugins(self) -> Iterator[tuple[str, Plugin]]:
+        """(slot, plug-in) for each slot that sees the batch."""
+        yield "resistance", self.resistance
+        yield "failure", self.failure
+
+    def plate_constants(self) -> dict[str, Parameter]:
+        """Every plate constant the model reads, by name."""
+        return {p.name: p for _, plugin in self.plugins() for p in plugin.plate_constants}
+
+    # -- binding ---------------------------------------------------------------------
+
+    def bind(self, batch: SceneBatch) -> BoundBatch:
+        """The batch with every per-scene constant the step loop needs, computed once and
+        namespaced: the plate constants each plug-in declared (checked against their
+        ranges, or their defaults where the plate has none), the columns each prepared,
+        ``onset_penetration`` [m] and ``rest_speed`` [m/s]."""
+        n = batch.size
+        given = batch.columns
+        columns = {name: given[name] for name in CORE_COLUMNS}
+        keys: dict[str, dict[str, str]] = {}
+        for slot, plugin in self.plugins():
+            visible = {name: name for name in CORE_COLUMNS}
+            for declared in plugin.plate_constants:
+                if declared.name not in columns:
+                    columns[declared.name] = _constant_column(declared, given, n, slot, plugin)
+                visible[declared.name] = declared.name
+            view = SceneBatch.of({k: columns[v] for k, v in visible.items()}, n)
+            prepared = plugin.prepare(view)  # type: ignore[attr-defined]
+            for name, values in _checked_columns(slot, plugin, prepared, n).items():
+                columns[f"{slot}.{name}"] = values
+                visible[name] = f"{slot}.{name}"
+            keys[slot] = visible
+        failure_view = SceneBatch.of({k: columns[v] for k, v in keys["failure"].items()}, n)
+        onset = np.broadcast_to(
+            np.asarray(self.failure.onset_penetration(failure_view), dtype=float), (n,)
         )
+        ONSET_PENETRATION.check(onset)
+        columns["onset_penetration"] = np.ascontiguousarray(onset)
+        columns["rest_speed"] = self.rest_speed_fraction * given["impact_speed"]
+        keys["core"] = {name: name for name in (*CORE_COLUMNS, "onset_penetration", "rest_speed")}
+        return BoundBatch(columns, keys, n)
 
     def new_failure_state(self, size: int) -> np.ndarray:
         """Failure-state array for ``size`` scenes, shape (len(state_names), size).
@@ -76,6 +126,8 @@ class ImpactModel:
         """
         return np.full((len(self.failure.state_names), size), np.nan)
 
+    # -- forces and rates --------------------------------------------------------------
+
     def forces(
         self,
         penetration: np.ndarray,
@@ -83,7 +135,7 @@ class ImpactModel:
         speed: np.ndarray,
         failed: np.ndarray,
         failure_state: np.ndarray,
-        batch: SceneBatch,
+        batch: BoundBatch,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Net drag and lift [N] on every scene (eqs 1, 15, 21–24).
 
@@ -94,10 +146,16 @@ class ImpactModel:
         """
         side = np.where(obliquity < 0.0, -1.0, 1.0)
         obliquity = np.abs(obliquity)
-        drag, lift = contact_force(self.resistance, penetration, obliquity, speed, batch)
+        law = batch.resistance
+        drag, lift = contact_force(self.resistance, penetration, obliquity, speed, law)
         if failed.all():  # no subset to take: every scene has failed
             extra_drag, extra_lift = self.failure.force_change(
-                penetration, obliquity, speed, failure_state, batch, self.resistance
+                penetration,
+                obliquity,
+                speed,
+                failure_state,
+                batch.failure,
+                BoundResistance(self.resistance, law),
             )
             return drag + extra_drag, side * (lift + extra_lift)
         if failed.any():
@@ -107,8 +165,8 @@ class ImpactModel:
                 obliquity[index],
                 speed[index],
                 failure_state[:, index],
-                batch.take(index),
-                self.resistance,
+                batch.failure.take(index),
+                BoundResistance(self.resistance, law.take(index)),
             )
             drag[index] += extra_drag
             lift[index] += extra_lift
@@ -121,13 +179,13 @@ class ImpactModel:
         obliquity: np.ndarray,
         speed: np.ndarray,
         failure_state: np.ndarray,
-        batch: SceneBatch,
+        batch: BoundBatch,
     ) -> None:
         """Set the failure state of the scenes in the boolean mask ``onset`` (in place)."""
         if failure_state.shape[0] and onset.any():
             index = np.flatnonzero(onset)
             failure_state[:, index] = self.failure.initial_state(
-                penetration[index], obliquity[index], speed[index], batch.take(index)
+                penetration[index], obliquity[index], speed[index], batch.failure.take(index)
             )
 
     def failure_state_rates(
@@ -138,7 +196,7 @@ class ImpactModel:
         obliquity_rate: np.ndarray,
         failed: np.ndarray,
         failure_state: np.ndarray,
-        batch: SceneBatch,
+        batch: BoundBatch,
     ) -> np.ndarray:
         """d(failure state)/dt; zero for intact scenes and stateless models."""
         rates = np.zeros_like(failure_state)
@@ -150,12 +208,12 @@ class ImpactModel:
                 speed[index],
                 obliquity_rate[index],
                 failure_state[:, index],
-                batch.take(index),
+                batch.failure.take(index),
             )
         return rates
 
     def rates(
-        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
+        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
         """dy/dt for the state rows of :data:`PENETRATION` ... (eqs 25–30 in time form):
         dP/dt = V cos θ, dY/dt = V sin θ, dθ/dt = lift/(m V) (0 where ``held`` at 180°),
@@ -163,12 +221,13 @@ class ImpactModel:
         pen, obl, spd = y[PENETRATION], y[OBLIQUITY], y[SPEED]
         failure_state = y[KINEMATIC_STATE:]
         drag, lift = self.forces(pen, obl, spd, failed, failure_state, batch)
-        obliquity_rate = np.where(held, 0.0, lift / (batch.mass * spd))
+        mass = batch.core.mass
+        obliquity_rate = np.where(held, 0.0, lift / (mass * spd))
         dy = np.empty_like(y)
         dy[PENETRATION] = spd * np.cos(obl)
         dy[LATERAL] = spd * np.sin(obl)
         dy[OBLIQUITY] = obliquity_rate
-        dy[SPEED] = -drag / batch.mass
+        dy[SPEED] = -drag / mass
         # The failure model sees the mirror image for θ < 0: |θ| and d|θ|/dt.
         side = np.where(obl < 0.0, -1.0, 1.0)
         dy[KINEMATIC_STATE:] = self.failure_state_rates(
@@ -176,95 +235,74 @@ class ImpactModel:
         )
         return dy
 
+    # -- events ------------------------------------------------------------------------
+
     def event_margins(
-        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
+        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
-        """Event functions, shape (5, n), rows :data:`ONSET` ... :data:`TURNED_BACK`.
+        """Event functions, shape (5, n), rows :data:`ONSET` ... :data:`TURNED_BACK`: the
+        one definition of the outcome rules.
 
         Each crosses zero upward at its event and is −inf where the event cannot happen:
         failure onset (P − P*, intact plates), contact lost (θ − π/2 − α1), perforation
         (the failure model's margin, failed plates, while θ < π/2), rest (V_rest − V),
-        turned back (θ − π + TURN_BACK_TOLERANCE, not yet held).
+        turned back (θ − π + TURN_BACK_TOLERANCE, not yet held). Where two are reached at
+        one point, the lower row wins: perforation over ricochet over embedment.
         """
         return np.stack([self.event_margin(k, y, failed, held, batch) for k in range(5)])
 
     def event_margin(
-        self, kind: int, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: SceneBatch
+        self, kind: int, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
         """One row of :meth:`event_margins`."""
         pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
+        core = batch.core
         if kind == ONSET:
-            return np.where(failed, -np.inf, pen - batch.onset_penetration)
+            return np.where(failed, -np.inf, pen - core.onset_penetration)
         if kind == CONTACT_LOST:
-            return contact_lost_margin(pen, obl, batch.radius)
+            return contact_lost_margin(pen, obl, core.radius)
         if kind == PERFORATED:
             return self._inward_perforation_margin(pen, obl, failed, batch)
         if kind == AT_REST:
-            return batch.rest_speed - y[SPEED]
+            return core.rest_speed - y[SPEED]
         if kind == TURNED_BACK:
             return np.where(held, -np.inf, obl - (self.MAX_OBLIQUITY - self.TURN_BACK_TOLERANCE))
         raise ValueError(f"no event {kind}")
 
-    def branch_margins(self, y: np.ndarray, failed: np.ndarray, batch: SceneBatch) -> np.ndarray:
+    def branch_margins(self, y: np.ndarray, failed: np.ndarray, batch: BoundBatch) -> np.ndarray:
         """Margins that cross zero where the force changes formula, shape (rows, n): the
         contact geometry's branch surfaces (:func:`geometry.branch_margins`), then the
         failure model's rows (:meth:`FailureModel.branch_margins`), NaN for intact scenes.
 
-        Not events: nothing changes there but the smoothness of the force. An adaptive
-        integrator uses them to step onto such a surface rather than across it.
+        Not events: nothing changes there but the smoothness of the force. The adaptive
+        step control steps onto such a surface rather than across it.
         """
         pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
-        rows = branch_margins(pen, obl, batch.radius)
+        rows = branch_margins(pen, obl, batch.core.radius)
         if not failed.any():
             return rows
         index = np.flatnonzero(failed)
         failure_rows = self.failure.branch_margins(
-            pen[index], obl[index], y[KINEMATIC_STATE:, index], batch.take(index)
+            pen[index], obl[index], y[KINEMATIC_STATE:, index], batch.failure.take(index)
         )
         extra = np.full((failure_rows.shape[0], pen.size), np.nan)
         extra[:, index] = failure_rows
         return np.concatenate([rows, extra])
 
     def perforation_margin(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        failed: np.ndarray,
-        batch: SceneBatch,
+        self, penetration: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
         """>= 0 where perforation is complete [m]; −inf where the plate is intact."""
         margin = np.full(penetration.shape, -np.inf)
         if failed.any():
             index = np.flatnonzero(failed)
             margin[index] = self.failure.perforation_margin(
-                penetration[index], np.abs(obliquity[index]), batch.take(index)
+                penetration[index], np.abs(obliquity[index]), batch.failure.take(index)
             )
         return margin
 
-    def classify(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        failed: np.ndarray,
-        at_rest: np.ndarray,
-        batch: SceneBatch,
-    ) -> np.ndarray:
-        """Outcome code per scene after a step: 0 while the impact goes on.
-
-        Perforation (front layer passed while moving inward) takes precedence over
-        ricochet (contact lost), which takes precedence over embedment (rest).
-        """
-        status = np.zeros(penetration.shape, dtype=np.int8)
-        obliquity = np.abs(obliquity)  # θ < 0: the mirror image
-        status[at_rest] = Outcome.EMBEDMENT
-        lost = contact_lost_margin(penetration, obliquity, batch.radius) >= 0.0
-        status[lost] = Outcome.RICOCHET
-        perforated = self._inward_perforation_margin(penetration, obliquity, failed, batch) >= 0.0
-        status[perforated] = Outcome.PERFORATION
-        return status
-
     def _inward_perforation_margin(
-        self, penetration: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: SceneBatch
+        self, penetration: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
         """The perforation margin where it counts: only while the sphere moves inward
         (θ < 90°); −inf elsewhere and on intact plates."""
@@ -282,3 +320,56 @@ class ImpactModel:
             "failure_settings": self.failure.settings(),
             "rest_speed_fraction": self.rest_speed_fraction,
         }
+
+
+def check_declarations(plugins: dict[str, Any]) -> None:
+    """Refuse, with one line, plug-ins whose declarations clash: one plate constant
+    declared two ways, or a prepared column that shadows a core column or constant."""
+    seen: dict[str, tuple[Parameter, str]] = {}
+    for slot, plugin in plugins.items():
+        label = f"{slot} {plugin.name!r}"
+        for declared in plugin.plate_constants:
+            if declared.name in CORE_COLUMNS:
+                raise PluginError(f"{label} declares plate constant {declared.name!r}, a core column")
+            if declared.name in seen and seen[declared.name][0] != declared:
+                raise PluginError(
+                    f"{seen[declared.name][1]} and {label} both claim plate constant "
+                    f"{declared.name!r} with different declarations"
+                )
+            seen.setdefault(declared.name, (declared, label))
+        shadowed = {c.name for c in plugin.columns} & (
+            set(CORE_COLUMNS) | {p.name for p in plugin.plate_constants}
+        )
+        if shadowed:
+            raise PluginError(f"{label} prepares column {sorted(shadowed)[0]!r}, a name it reads")
+
+
+def _constant_column(
+    declared: Parameter, given: dict[str, np.ndarray], n: int, slot: str, plugin: Plugin
+) -> np.ndarray:
+    """The plate constant a plug-in declared: the plate's, checked, or its default."""
+    if declared.name in given:
+        declared.check(given[declared.name])
+        return given[declared.name]
+    if declared.has_default:
+        return np.full(n, float(declared.default))  # type: ignore[arg-type]
+    raise ParameterError(
+        declared.name,
+        f"{declared.name} ({declared.description}) is needed by {slot} {plugin.name!r} and "
+        f"has no default: give the plate one ({declared.describe_range()})",
+    )
+
+
+def _checked_columns(
+    slot: str, plugin: Plugin, prepared: dict[str, Any], n: int
+) -> dict[str, np.ndarray]:
+    """The columns a plug-in prepared, exactly those it declared, one float per scene."""
+    declared = [c.name for c in plugin.columns]
+    if set(prepared) != set(declared):
+        extra, missing = sorted(set(prepared) - set(declared)), sorted(set(declared) - set(prepared))
+        what = f"undeclared column {extra[0]!r}" if extra else f"no column {missing[0]!r}"
+        raise PluginError(f"{slot} {plugin.name!r}: prepare() returned {what}")
+    return {
+        name: np.ascontiguousarray(np.broadcast_to(np.asarray(prepared[name], float), (n,)))
+        for name in declared
+    }

@@ -1,29 +1,37 @@
 """Figures in the layout of the report: outcome curves against impact speed, craters.
 
 matplotlib is imported here only, so the rest of plateimpact does not need a display
-or pay the import time. Functions draw on axes you pass and return them.
+or pay the import time. Figures are made as :class:`matplotlib.figure.Figure` objects,
+not through pyplot: nothing here touches the user's backend or pyplot's state, so the
+functions work the same in a script, a notebook and an interactive session. Functions
+draw on axes you pass and return them; :func:`figure` gives a figure and its axes.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # files, not windows: studies and CI run headless
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.axes import Axes  # noqa: E402
-
-from .crater import CraterSection  # noqa: E402
-from .results import BatchResult, Outcome, Trajectory  # noqa: E402
+from .results import BatchResult, CraterSection, Outcome, Trajectory
 
 if TYPE_CHECKING:
     from .calibration import DriFit
-    from .shots import Shots
+    from .storage.shots import Shots
     from .study import StudyResults
+
+#: Resolution of saved figures [dots per inch].
+DPI = 120
+
+
+def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
+    """A new figure (outside pyplot) and its axes, as ``pyplot.subplots`` returns them."""
+    fig = Figure(figsize=kwargs.pop("figsize", None), layout=kwargs.pop("layout", None))
+    return fig, fig.subplots(nrows, ncols, **kwargs)
 
 OUTCOME_SHADES = {
     Outcome.RICOCHET: "#dbe9f6",
@@ -146,13 +154,12 @@ def plot_calibration(
     return ax
 
 
-def save(fig: plt.Figure, path: str) -> None:
-    """Save and close a figure."""
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
+def save(fig: Figure, path: str) -> None:
+    """Save a figure [PNG by the file's extension]."""
+    fig.savefig(path, dpi=DPI, bbox_inches="tight")
 
 
-def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> plt.Figure:
+def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> Figure:
     """Exit speed and exit obliquity against impact speed for every plate × obliquity of a
     study: one column per (plate, obliquity), the first run solid with its outcome ranges
     shaded, further runs dashed on top (the report's comparison layout, Figures 30–31)."""
@@ -165,7 +172,7 @@ def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> plt.
         for label in dict.fromkeys(study.plate_labels)
         for ob in sorted(set(obliquity[labels == label]))
     ]
-    fig, axes = plt.subplots(
+    fig, axes = figure(
         2,
         len(panels),
         figsize=(3.2 * len(panels), 6),
@@ -224,7 +231,7 @@ def plot_study_paths(
     kind: str = "crater",
     speeds: Sequence[float] | None = None,
     count: int = 6,
-) -> plt.Figure:
+) -> Figure:
     """Crater sections (eqs 31–39) or the centre's trajectories, one panel per plate ×
     obliquity of a study, one line per impact speed [m/s] (``speeds``: the scenes nearest
     these; default ``count`` spread over the range); the first run solid, others dashed.
@@ -242,12 +249,12 @@ def plot_study_paths(
             need = "craters=True" if kind == "crater" else "record_trajectory=True"
             raise ValueError(f"run {run!r} has no {kind} data: run the study with {need}")
     panels = _panels(results)
-    fig, axes = plt.subplots(
+    fig, axes = figure(
         len(panels), 1, figsize=(8, 2.6 * len(panels)), squeeze=False, layout="constrained"
     )
     for ax, (label, ob, index) in zip(axes[:, 0], panels, strict=True):
         chosen = index[_pick(study.scenes.impact_speed[index], speeds, count)]
-        colours = plt.cm.viridis(np.linspace(0.0, 0.9, chosen.size))
+        colours = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, chosen.size))
         thickness = study.scenes.thickness[chosen[0]] * 1e3
         for k, run in enumerate(runs):
             result = results[run]
@@ -255,7 +262,7 @@ def plot_study_paths(
                 style = {"color": colour, "ls": "-" if k == 0 else "--", "lw": 1.2}
                 name = f"{study.scenes.impact_speed[i]:g} m/s, {Outcome(result.outcome[i]).label}"
                 if kind == "crater":
-                    section = result.craters.section(i)
+                    section = result.crater_of(i)
                     ax.plot(section.lateral * 1e3, section.depth * 1e3, label=name, **style)
                 else:
                     path = result.trajectory_of(i)

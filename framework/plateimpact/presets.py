@@ -18,12 +18,25 @@ SAE_52100_DENSITY = 7830.0
 
 DEFAULT_SPHERE = Sphere.of_density(radius=0.5 * 6.35 * mm, density=SAE_52100_DENSITY)
 
+
+def _table_1(material: str, thickness_mm: float, a: float, b: float, pstar_mm: float) -> Plate:
+    """A row of Table 1: a [N/m²], b [kg/m³] (eq 1), P* [mm] and α* = 45° (eq 8)."""
+    return Plate(
+        material,
+        thickness_mm * mm,
+        a=a,
+        b=b,
+        critical_penetration=pstar_mm * mm,
+        failure_angle=45 * deg,
+    )
+
+
 PLATES: dict[str, Plate] = {
-    "2024-T3/1.27": Plate("2024-T3", 1.27 * mm, 0.272e9, 0.129e4, 2.2 * mm, 45 * deg),
-    "2024-T3/3.18": Plate("2024-T3", 3.18 * mm, 0.101e10, 0.126e4, 3.0 * mm, 45 * deg),
-    "2024-T3/6.35": Plate("2024-T3", 6.35 * mm, 0.933e9, 0.974e3, 6.4 * mm, 45 * deg),
-    "6061-T6/9.53": Plate("6061-T6", 9.52 * mm, 0.112e10, 0.580e3, 7.5 * mm, 45 * deg),
-    "SAE1010/1.47": Plate("SAE1010", 1.47 * mm, 0.380e9, 0.148e4, 4.6 * mm, 45 * deg),
+    "2024-T3/1.27": _table_1("2024-T3", 1.27, 0.272e9, 0.129e4, 2.2),
+    "2024-T3/3.18": _table_1("2024-T3", 3.18, 0.101e10, 0.126e4, 3.0),
+    "2024-T3/6.35": _table_1("2024-T3", 6.35, 0.933e9, 0.974e3, 6.4),
+    "6061-T6/9.53": _table_1("6061-T6", 9.52, 0.112e10, 0.580e3, 7.5),
+    "SAE1010/1.47": _table_1("SAE1010", 1.47, 0.380e9, 0.148e4, 4.6),
 }
 
 

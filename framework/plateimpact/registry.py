@@ -6,17 +6,19 @@ import functools
 from collections.abc import Iterable
 from typing import Any
 
-import attrs
 import pluggy
 
 from . import hookspecs
-from .errors import ParameterError, UnknownNameError
+from .batch import CORE_COLUMNS
+from .errors import ParameterError, PluginError, UnknownNameError
 from .failure import FailureModel
 from .integrator import Integrator
+from .parameters import Parameter
+from .plugin import Plugin
 from .resistance import ResistanceLaw
 
-#: The kinds of plug-in, by the word users and the CLI use for them.
-KINDS: dict[str, type] = {
+#: The kinds of plug-in, by the word users and the CLI use for them (the model's slots).
+KINDS: dict[str, type[Plugin]] = {
     "resistance": ResistanceLaw,
     "failure": FailureModel,
     "integrator": Integrator,
@@ -24,34 +26,77 @@ KINDS: dict[str, type] = {
 
 
 class PluginRegistry:
-    """Name → class tables, one per kind of plug-in."""
+    """Name → class tables, one per kind of plug-in, and the plate constants they declare.
+
+    Registering checks a class's declarations: a plate constant may be declared by several
+    plug-ins only with equal declarations, so that a plate's ``a`` means one thing
+    whatever model reads it; a plug-in's settings, plate constants and prepared columns
+    may not share a name.
+    """
 
     def __init__(self) -> None:
-        self._classes: dict[str, dict[str, type]] = {kind: {} for kind in KINDS}
+        self._classes: dict[str, dict[str, type[Plugin]]] = {kind: {} for kind in KINDS}
         self._origin: dict[tuple[str, str], str] = {}
+        self._constants: dict[str, tuple[Parameter, list[str]]] = {}
 
     def add(self, cls: type) -> None:
         """Register a concrete ResistanceLaw, FailureModel or Integrator subclass."""
         kinds = [k for k, base in KINDS.items() if isinstance(cls, type) and issubclass(cls, base)]
         if len(kinds) != 1:
-            raise TypeError(f"{cls!r} is not a ResistanceLaw, FailureModel or Integrator")
+            raise PluginError(f"{cls!r} is not a ResistanceLaw, FailureModel or Integrator")
         name = getattr(cls, "name", None)
         if not isinstance(name, str) or not name:
-            raise TypeError(f"{cls.__qualname__} has no 'name'")
+            raise PluginError(f"{cls.__qualname__} ({cls.__module__}) has no 'name'")
         kind = kinds[0]
+        label = f"{kind} {name!r} ({cls.__module__})"
         if name in self._classes[kind] and self._classes[kind][name] is not cls:
-            raise ValueError(
+            raise PluginError(
                 f"{kind} {name!r} is registered twice: by {self._origin[kind, name]} "
                 f"and by {cls.__module__}"
             )
+        self._check_declarations(cls, label)
+        for declared in cls.plate_constants:
+            entry = self._constants.setdefault(declared.name, (declared, []))
+            entry[1].append(f"{kind} {name}")
         self._classes[kind][name] = cls
         self._origin[kind, name] = cls.__module__
+
+    def _check_declarations(self, cls: type[Plugin], label: str) -> None:
+        constants = list(cls.plate_constants)
+        if not all(isinstance(p, Parameter) for p in constants):
+            raise PluginError(f"{label}: plate_constants must be Parameter declarations")
+        settings = set(cls.setting_declarations())
+        names = [p.name for p in constants]
+        columns = [c.name for c in cls.columns]
+        for group in (names, columns):
+            if len(set(group)) != len(group):
+                raise PluginError(f"{label} declares a name twice: {sorted(group)}")
+        clash = (set(names) & settings) | (set(columns) & (settings | set(names)))
+        clash |= (set(names) | set(columns)) & set(CORE_COLUMNS)
+        if clash:
+            raise PluginError(f"{label} uses the name {sorted(clash)[0]!r} for two things")
+        for declared in constants:
+            known = self._constants.get(declared.name)
+            if known is not None and known[0] != declared:
+                raise PluginError(
+                    f"{label} declares plate constant {declared.name!r} unlike "
+                    f"{', '.join(known[1])}: declare the same Parameter object"
+                )
+
+    @property
+    def plate_constants(self) -> dict[str, Parameter]:
+        """Every plate constant a registered plug-in declares, by name."""
+        return {name: declared for name, (declared, _) in self._constants.items()}
+
+    def declared_by(self, constant: str) -> list[str]:
+        """The plug-ins (``"failure plugging"``) that declare a plate constant."""
+        return list(self._constants.get(constant, (None, []))[1])
 
     def names(self, kind: str) -> list[str]:
         """Registered names of one kind, sorted."""
         return sorted(self._classes[kind])
 
-    def get(self, kind: str, name: str) -> type:
+    def get(self, kind: str, name: str) -> type[Plugin]:
         """The class registered as ``name``; UnknownNameError lists the choices."""
         try:
             return self._classes[kind][name]
@@ -60,20 +105,18 @@ class PluginRegistry:
             raise UnknownNameError(f"unknown {kind} {name!r}; choose from: {choices}") from None
 
     def create(self, kind: str, name: str, **settings: Any) -> Any:
-        """An instance of the ``name`` plug-in with ``settings``.
+        """An instance of the ``name`` plug-in with ``settings`` [SI].
 
         Unknown settings, and settings a plug-in rejects, raise ParameterError.
         """
         cls = self.get(kind, name)
-        if attrs.has(cls):
-            known = {f.name for f in attrs.fields(cls) if f.init}
-            unknown = sorted(set(settings) - known)
-            if unknown:
-                allowed = ", ".join(sorted(known)) or "none"
-                raise ParameterError(
-                    unknown[0],
-                    f"{kind} {name!r} has no setting {unknown[0]!r}; settings: {allowed}",
-                )
+        known = cls.setting_declarations()
+        unknown = sorted(set(settings) - set(known))
+        if unknown:
+            allowed = ", ".join(sorted(known)) or "none"
+            raise ParameterError(
+                unknown[0], f"{kind} {name!r} has no setting {unknown[0]!r}; settings: {allowed}"
+            )
         try:
             return cls(**settings)
         except TypeError as exc:

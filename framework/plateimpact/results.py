@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import enum
 import math
-from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
 
-if TYPE_CHECKING:
-    from .crater import CraterSections
+from .parameters import Parameter
+from .ragged import Ragged
+
+_DEG, _MM = math.pi / 180.0, 1e-3
 
 
 class Outcome(enum.IntEnum):
@@ -26,14 +27,105 @@ class Outcome(enum.IntEnum):
         return self.name.lower()
 
 
-#: Columns of a recorded trajectory, with units.
-TRAJECTORY_FIELDS = {
-    "time": "s",
-    "penetration": "m",
-    "lateral": "m",
-    "obliquity": "rad",
-    "speed": "m/s",
+#: Per-scene result columns, with their units: the one source of what archives, CSV
+#: headers and JSON keys call them.
+RESULT_FIELDS: dict[str, Parameter] = {
+    p.name: p
+    for p in (
+        Parameter("outcome", "1 ricochet, 2 embedment, 3 perforation", kind=int),
+        Parameter("exit_speed", "speed when contact ends (0 for embedment)", "m/s"),
+        Parameter(
+            "exit_obliquity",
+            "direction from the plate normal when contact ends, or at rest",
+            "rad",
+            display_unit="deg",
+            scale=_DEG,
+        ),
+        Parameter("contact_time", "time from first contact to the outcome", "s"),
+        Parameter("max_penetration", "largest penetration P reached", "m", display_unit="mm", scale=_MM),
+        Parameter("plate_failed", "whether the plate failed (P reached the onset penetration)", kind=bool),
+        Parameter("failure_time", "time of plate failure (NaN: none)", "s"),
+        Parameter(
+            "failure_penetration", "penetration at plate failure (NaN: none)", "m", display_unit="mm", scale=_MM
+        ),
+        Parameter(
+            "failure_lateral",
+            "lateral displacement at plate failure (NaN: none)",
+            "m",
+            display_unit="mm",
+            scale=_MM,
+        ),
+    )
 }
+#: Columns of a recorded trajectory (then ``failure_<state>`` for the failure state).
+TRAJECTORY_FIELDS: dict[str, Parameter] = {
+    p.name: p
+    for p in (
+        Parameter("time", "time since first contact", "s"),
+        Parameter(
+            "penetration",
+            "depth P of the sphere's deepest point below the front surface",
+            "m",
+            display_unit="mm",
+            scale=_MM,
+        ),
+        Parameter("lateral", "lateral displacement Y of the sphere's centre", "m", display_unit="mm", scale=_MM),
+        Parameter(
+            "obliquity",
+            "direction theta of the velocity from the plate normal",
+            "rad",
+            display_unit="deg",
+            scale=_DEG,
+        ),
+        Parameter("speed", "speed V", "m/s"),
+    )
+}
+#: Columns of crater sections (eqs 31-39): per point, then per scene.
+CRATER_FIELDS: dict[str, Parameter] = {
+    p.name: p
+    for p in (
+        Parameter(
+            "lateral", "distance along the plate from the crater's entry point", "m", display_unit="mm", scale=_MM
+        ),
+        Parameter("depth", "depth of the crater floor below the front surface", "m", display_unit="mm", scale=_MM),
+        Parameter(
+            "impact_point",
+            "lateral position of first contact in the section's coordinates",
+            "m",
+            display_unit="mm",
+            scale=_MM,
+        ),
+    )
+}
+
+
+@attrs.frozen(eq=False)
+class CraterSection:
+    """The crater floor in the plane of motion, from entry to exit.
+
+    Attributes
+    ----------
+    lateral : ndarray
+        Distance along the plate from the crater's entry point [m]; starts at 0.
+    depth : ndarray
+        Depth of the floor below the front surface [m], >= 0; starts at 0.
+    impact_point : float
+        Lateral position of the first-contact point in these coordinates [m].
+    """
+
+    lateral: np.ndarray
+    depth: np.ndarray
+    impact_point: float
+
+    @property
+    def length(self) -> float:
+        """Crater length along the plate [m]."""
+        return float(self.lateral[-1] - self.lateral[0])
+
+    @property
+    def max_depth(self) -> float:
+        """Deepest point of the floor [m]."""
+        return float(self.depth.max())
 
 
 @attrs.frozen(eq=False)
@@ -94,97 +186,71 @@ class Result:
         return math.degrees(self.exit_obliquity)
 
     def as_user_dict(self) -> dict[str, object]:
-        """The result in the user's units (mm, m/s, s, degrees), as the CLI prints it."""
-        return {
-            "outcome": self.outcome.label,
-            "exit_speed_m_s": self.exit_speed,
-            "exit_obliquity_deg": self.exit_obliquity_deg,
-            "contact_time_s": self.contact_time,
-            "max_penetration_mm": self.max_penetration * 1e3,
-            "plate_failed": self.plate_failed,
-            "failure_time_s": None if not self.plate_failed else self.failure_time,
-            "failure_penetration_mm": None
-            if not self.plate_failed
-            else self.failure_penetration * 1e3,
-            "failure_lateral_mm": None if not self.plate_failed else self.failure_lateral * 1e3,
-        }
-
-
-#: Per-scene result columns of a batch, with units.
-RESULT_FIELDS = {
-    "outcome": "",
-    "exit_speed": "m/s",
-    "exit_obliquity": "rad",
-    "contact_time": "s",
-    "max_penetration": "m",
-    "plate_failed": "",
-    "failure_time": "s",
-    "failure_penetration": "m",
-    "failure_lateral": "m",
-}
+        """The result in the user's units (mm, m/s, s, degrees), keys with their units
+        (``exit_speed_m_s``), as the CLI prints it; failure values None if it did not."""
+        out: dict[str, object] = {"outcome": self.outcome.label}
+        for name, field in RESULT_FIELDS.items():
+            value = getattr(self, name)
+            if name == "outcome":
+                continue
+            if name.startswith("failure_") and not self.plate_failed:
+                out[field.key] = None
+            elif isinstance(value, float):
+                out[field.key] = value / field.scale
+            else:
+                out[field.key] = value
+        return out
 
 
 class BatchResult:
     """Results of a batch as arrays (one entry per scene, in the batch's order).
 
-    Trajectories, when recorded, are stored as contiguous ragged arrays: every sample of
-    every scene concatenated in ``trajectory[field]``, scene ``i`` owning the slice
-    ``trajectory_offsets[i]:trajectory_offsets[i + 1]``. Crater sections, when asked for,
-    are a :class:`~plateimpact.crater.CraterSections` in ``craters``.
+    ``trajectory`` (when recorded) and ``craters`` (when asked for) are
+    :class:`~plateimpact.ragged.Ragged` arrays with one row per scene: the trajectory's
+    columns are :data:`TRAJECTORY_FIELDS` then ``failure_<state>``; the craters' are
+    ``lateral`` and ``depth`` per point and ``impact_point`` per scene
+    (:data:`CRATER_FIELDS`). ``stats`` counts the integrator's work.
     """
 
     def __init__(
         self,
         columns: dict[str, np.ndarray],
-        trajectory: dict[str, np.ndarray] | None = None,
-        trajectory_counts: np.ndarray | None = None,
-        stats: dict[str, float] | None = None,
-        craters: CraterSections | None = None,
+        trajectory: Ragged | None = None,
+        stats: dict[str, int] | None = None,
+        craters: Ragged | None = None,
     ) -> None:
         missing = set(RESULT_FIELDS) - set(columns)
         if missing:
             raise ValueError(f"result columns missing: {sorted(missing)}")
         self.columns = columns
         self.trajectory = trajectory
-        self.trajectory_counts = trajectory_counts
         self.stats = stats or {}
         self.craters = craters
-        if trajectory_counts is not None:
-            self.trajectory_offsets = np.concatenate([[0], np.cumsum(trajectory_counts)])
 
     @classmethod
     def concat(cls, parts: list[BatchResult]) -> BatchResult:
-        """One result holding ``parts`` in order (e.g. the chunks of a threaded run)."""
+        """One result holding ``parts`` in order (e.g. the chunks of a parallel run)."""
         columns = {k: np.concatenate([p.columns[k] for p in parts]) for k in parts[0].columns}
         stats = {k: sum(p.stats.get(k, 0) for p in parts) for k in parts[0].stats}
-        craters = None
+        trajectory = craters = None
+        if parts[0].trajectory is not None:
+            trajectory = Ragged.concat([p.trajectory for p in parts])  # type: ignore[misc]
         if parts[0].craters is not None:
-            craters = type(parts[0].craters).concat([p.craters for p in parts])
-        if parts[0].trajectory is None:
-            return cls(columns, stats=stats, craters=craters)
-        trajectory = {
-            k: np.concatenate([p.trajectory[k] for p in parts]) for k in parts[0].trajectory
-        }
-        counts = np.concatenate([p.trajectory_counts for p in parts])
-        return cls(columns, trajectory, counts, stats, craters)
+            craters = Ragged.concat([p.craters for p in parts])  # type: ignore[misc]
+        return cls(columns, trajectory, stats, craters)
 
     def __len__(self) -> int:
-        return self.columns["outcome"].size
+        return int(self.columns["outcome"].size)
 
     def take(self, index: np.ndarray) -> BatchResult:
         """The results of the scenes ``index`` (integer array), trajectories included."""
         index = np.asarray(index, dtype=int)
-        columns = {k: c[index] for k, c in self.columns.items()}
-        craters = None if self.craters is None else self.craters.take(index)
-        if self.trajectory is None:
-            return BatchResult(columns, stats=dict(self.stats), craters=craters)
-        pieces = [
-            np.arange(self.trajectory_offsets[i], self.trajectory_offsets[i + 1]) for i in index
-        ]
-        samples = np.concatenate(pieces) if pieces else np.zeros(0, dtype=int)
-        trajectory = {k: x[samples] for k, x in self.trajectory.items()}
-        counts = self.trajectory_counts[index]
-        return BatchResult(columns, trajectory, counts, dict(self.stats), craters)
+        return BatchResult(
+            {k: c[index] for k, c in self.columns.items()},
+            None if self.trajectory is None else self.trajectory.take(index),
+            dict(self.stats),
+            None if self.craters is None else self.craters.take(index),
+        )
 
     def __getattr__(self, name: str) -> np.ndarray:
         try:
@@ -196,15 +262,16 @@ class BatchResult:
         """The trajectory of scene ``i``, or None when none was recorded."""
         if self.trajectory is None:
             return None
-        lo, hi = self.trajectory_offsets[i], self.trajectory_offsets[i + 1]
-        state = {
-            k.removeprefix("failure_"): v[lo:hi]
-            for k, v in self.trajectory.items()
-            if k.startswith("failure_")
-        }
-        return Trajectory(
-            **{k: self.trajectory[k][lo:hi] for k in TRAJECTORY_FIELDS}, failure_state=state
-        )
+        row = self.trajectory.row(i)
+        state = {k.removeprefix("failure_"): v for k, v in row.items() if k.startswith("failure_")}
+        return Trajectory(**{k: row[k] for k in TRAJECTORY_FIELDS}, failure_state=state)
+
+    def crater_of(self, i: int) -> CraterSection | None:
+        """The crater section of scene ``i``, or None when none was computed."""
+        if self.craters is None:
+            return None
+        row = self.craters.row(i)
+        return CraterSection(row["lateral"], row["depth"], float(self.craters["impact_point"][i]))
 
     def result(self, i: int) -> Result:
         """Scene ``i`` as a :class:`Result`."""

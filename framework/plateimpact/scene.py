@@ -2,10 +2,25 @@
 
 from __future__ import annotations
 
+import math
+
 import attrs
 
-from . import validation as v
 from .bodies import Plate, Sphere
+from .parameters import Parameter, Range
+
+IMPACT_SPEED = Parameter(
+    "impact_speed", "impact speed Vs", "m/s", Range(0.0, low_open=True), flag="--speed"
+)
+IMPACT_OBLIQUITY = Parameter(
+    "impact_obliquity",
+    "impact obliquity theta_s, the velocity's angle from the plate's inward normal",
+    "rad",
+    Range(0.0, math.pi / 2, high_open=True),
+    "deg",
+    math.pi / 180,
+    flag="--obliquity",
+)
 
 
 @attrs.frozen
@@ -24,5 +39,5 @@ class Scene:
 
     sphere: Sphere = attrs.field(validator=attrs.validators.instance_of(Sphere))
     plate: Plate = attrs.field(validator=attrs.validators.instance_of(Plate))
-    impact_speed: float = v.IMPACT_SPEED.field()
-    impact_obliquity: float = v.IMPACT_OBLIQUITY.field()
+    impact_speed: float = IMPACT_SPEED.field()
+    impact_obliquity: float = IMPACT_OBLIQUITY.field()

@@ -10,19 +10,22 @@ import attrs
 import numpy as np
 
 from .batch import SceneBatch
-from .crater import CraterSections
+from .crater import crater_sections
+from .driver import integrate
 from .errors import ParameterError
 from .integrator import Integrator
-from .model import ImpactModel
+from .model import REST_SPEED_FRACTION, ImpactModel
 from .registry import PluginRegistry, default_registry
 from .results import BatchResult, Result
 from .scene import Scene
 
+#: The plug-ins a model uses unless told otherwise (the report's model).
 DEFAULT_RESISTANCE = "poncelet"
 DEFAULT_FAILURE = "plugging"
 DEFAULT_INTEGRATOR = "dopri5"
-#: Scenes per task when a batch is spread over an executor: large enough that the step
-#: loop's per-iteration overhead is spread over many scenes, small enough to balance.
+#: Scenes per task when a batch is spread over an executor or a study runs in chunks:
+#: large enough that the step loop's per-iteration overhead (about 1 ms) is spread over
+#: many scenes, small enough to balance work and to move a progress bar.
 DEFAULT_CHUNK_SIZE = 2500
 
 
@@ -47,7 +50,7 @@ class Simulation:
         resistance_settings: Mapping[str, Any] | None = None,
         failure_settings: Mapping[str, Any] | None = None,
         integrator_settings: Mapping[str, Any] | None = None,
-        rest_speed_fraction: float = 1e-2,
+        rest_speed_fraction: float = REST_SPEED_FRACTION.default,  # type: ignore[assignment]
         registry: PluginRegistry | None = None,
     ) -> Simulation:
         """Resolve each slot by name from ``registry`` (default: installed plug-ins)."""
@@ -125,11 +128,14 @@ def run_chunk(
 ) -> BatchResult:
     """One chunk of a batch, in an executor's worker (picklable: a module function);
     crater sections, when asked for, are computed there too."""
-    result = simulation.integrator.run(
-        simulation.model, batch, record_trajectory=record_trajectory or craters
+    result = integrate(
+        simulation.model,
+        simulation.integrator,
+        batch,
+        record_trajectory=record_trajectory or craters,
     )
     if craters:
-        result.craters = CraterSections.from_result(result, batch.radius, batch.thickness)
+        result.craters = crater_sections(result, batch.radius, batch.thickness)
     return result
 
 

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import json
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from concurrent.futures import Executor
 from pathlib import Path
-from typing import Any
 
 import attrs
 import numpy as np
@@ -19,78 +18,11 @@ from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult, Outcome
 from .scene import Scene
-from .simulation import (
-    DEFAULT_FAILURE,
-    DEFAULT_INTEGRATOR,
-    DEFAULT_RESISTANCE,
-    Simulation,
-    check_chunk_size,
-    run_chunk,
-)
+from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
+from .storage.archive import Archive
+from .storage.provenance import RunMetadata
+from .variant import Variant, check_name
 
-#: Scenes per task: hundreds to thousands, so the step loop's fixed cost per iteration
-#: is spread over many scenes while a progress bar still moves.
-DEFAULT_CHUNK_SIZE = 1000
-
-
-def _json_value(value: object) -> object:
-    """Settings as JSON values, so that a variant is archived and read back unchanged."""
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if hasattr(value, "as_setting"):  # e.g. a PstarTable: its rows
-        return value.as_setting()
-    raise ParameterError("settings", f"setting value {value!r} is not a JSON value")
-
-
-def _settings(value: Mapping[str, Any] | None) -> dict[str, Any]:
-    return json.loads(json.dumps(dict(value or {}), default=_json_value, sort_keys=True))
-
-
-def _check_name(instance: object, attribute: attrs.Attribute, value: str) -> None:
-    if not isinstance(value, str) or not value or "/" in value or value != value.strip():
-        raise ParameterError(
-            attribute.name, f"{attribute.name} must be a non-empty name without '/', got {value!r}"
-        )
-
-
-@attrs.frozen
-class Variant:
-    """One model variant of a study: plug-in names and their settings.
-
-    Settings are held as JSON values (a :class:`PstarTable` becomes its rows), exactly as
-    the archive stores them, so a variant read back from an archive equals this one.
-    """
-
-    name: str = attrs.field(validator=_check_name)
-    resistance: str = DEFAULT_RESISTANCE
-    failure: str = DEFAULT_FAILURE
-    integrator: str = DEFAULT_INTEGRATOR
-    resistance_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
-    failure_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
-    integrator_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
-    rest_speed_fraction: float = 1e-2
-
-    def simulation(self, registry: PluginRegistry | None = None) -> Simulation:
-        """The resolved model and integrator (plug-ins looked up by name once)."""
-        return Simulation.from_names(
-            self.resistance,
-            self.failure,
-            self.integrator,
-            resistance_settings=self.resistance_settings,
-            failure_settings=self.failure_settings,
-            integrator_settings=self.integrator_settings,
-            rest_speed_fraction=self.rest_speed_fraction,
-            registry=registry,
-        )
-
-    def to_json(self) -> str:
-        return json.dumps(attrs.asdict(self), sort_keys=True)
-
-    @classmethod
-    def from_json(cls, text: str) -> Variant:
-        return cls(**json.loads(text))
 
 
 def _variants(value: Iterable[Variant] | Variant) -> tuple[Variant, ...]:
@@ -129,7 +61,7 @@ class Study:
     description : str
     """
 
-    name: str = attrs.field(validator=_check_name)
+    name: str = attrs.field(validator=check_name)
     scenes: SceneBatch = attrs.field(validator=attrs.validators.instance_of(SceneBatch))
     variants: tuple[Variant, ...] = attrs.field(converter=_variants)
     plate_labels: tuple[str, ...] = attrs.field(converter=_labels)
@@ -178,6 +110,14 @@ class Study:
         labels = [_plate_label(s.plate) for s in scenes]
         return cls(name, SceneBatch.from_scenes(scenes), variants, labels, description)
 
+    @classmethod
+    def from_archive(cls, path: str | os.PathLike[str], name: str | None = None) -> Study:
+        """The study ``name`` (or the archive's only one) as it was defined."""
+        record = Archive(path).study(name)
+        return cls(
+            record.name, record.scenes, record.variants, record.plate_labels, record.description
+        )
+
     def variant(self, name: str) -> Variant:
         for variant in self.variants:
             if variant.name == name:
@@ -221,8 +161,6 @@ class Study:
         progress : bool or None
             Progress bar on stderr; None shows it on a terminal only.
         """
-        from .archive import Archive, RunMetadata  # noqa: PLC0415 (archive imports study)
-
         check_chunk_size(chunk_size)
         writer = Archive(archive) if archive is not None else None
         if writer is not None:
@@ -230,6 +168,13 @@ class Study:
         if resume and writer is None:
             raise ParameterError("resume", "resume=True needs the archive to resume from")
         finished = writer.finished_runs(self) if resume else {}
+        simulations = {
+            v.name: v.simulation(registry) for v in self.variants if v.name not in finished
+        }
+        constants = {}
+        for simulation in simulations.values():  # a bad plate constant: refused before any run
+            simulation.model.bind(self.scenes)
+            constants.update(simulation.model.plate_constants())
         runs: dict[str, BatchResult] = {}
         with progress_bar(self.scenes.size * len(self.variants), self.name, progress) as bar:
             for variant in self.variants:
@@ -242,7 +187,7 @@ class Study:
                         runs[variant.name] = kept
                         bar.update(self.scenes.size)
                         continue
-                simulation = variant.simulation(registry)
+                simulation = simulations.get(variant.name) or variant.simulation(registry)
                 metadata = RunMetadata(variant, simulation)
                 chunks = [
                     self.scenes.take(np.arange(lo, min(lo + chunk_size, self.scenes.size)))
@@ -265,7 +210,7 @@ class Study:
                 metadata.finish()
                 runs[variant.name] = result
                 if writer is not None:
-                    writer.append_run(self, variant, result, metadata.as_attributes())
+                    writer.append_run(self, variant, result, metadata.as_attributes(), constants)
         return StudyResults(self, runs)
 
 
@@ -315,6 +260,18 @@ class StudyResults:
     def __init__(self, study: Study, runs: Mapping[str, BatchResult]) -> None:
         self.study = study
         self.runs = dict(runs)
+
+    @classmethod
+    def from_archive(cls, path: str | os.PathLike[str], study: str | None = None) -> StudyResults:
+        """A study (or the archive's only one) and all its runs, by run name."""
+        archive = Archive(path)
+        definition = Study.from_archive(path, study)
+        runs = {
+            r.split("/", 1)[1]: archive.results(r)
+            for r in archive.runs()
+            if r.split("/", 1)[0] == definition.name
+        }
+        return cls(definition, runs)
 
     def __getitem__(self, name: str) -> BatchResult:
         try:

@@ -12,6 +12,7 @@ from .dopri5 import DormandPrince54
 from .embedded_rk import EmbeddedRungeKutta
 from .hinge import Hinge
 from .intact import Intact
+from .plate_constants import CRITICAL_PENETRATION, DENSITY_B, FAILURE_ANGLE, STRENGTH_A
 from .plugging import Plugging
 from .poncelet import Poncelet
 from .scipy_ivp import ScipyIVP
@@ -20,7 +21,11 @@ from .separation import PlaneSeparation
 from .variable_pstar import SAE1010_TABLE, PstarTable, VariablePstar
 
 __all__ = [
+    "CRITICAL_PENETRATION",
+    "DENSITY_B",
+    "FAILURE_ANGLE",
     "SAE1010_TABLE",
+    "STRENGTH_A",
     "DormandPrince54",
     "EmbeddedRungeKutta",
     "Hinge",

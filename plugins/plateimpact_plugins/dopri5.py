@@ -15,20 +15,10 @@ from .embedded_rk import EmbeddedRungeKutta
 class DormandPrince54(EmbeddedRungeKutta):
     """Dormand & Prince (1980) 5(4) pair, FSAL, with Shampine's 4th-order dense output
     (the coefficients of scipy's RK45). Error estimate of order 4, so the step follows
-    err^(−1/5). See :class:`EmbeddedRungeKutta` for error control and events.
-
-    Parameters
-    ----------
-    rtol : float
-        Local error tolerance relative to each component's scale, in [1e-14, 1e-2];
-        default 1e-8 (exit speed within 2e-7 of the impact speed and exit obliquity within
-        1e-5° of the reference on the benchmark set: docs/integrators.md).
-    max_steps : int
-    fixed_step : float or None
-        A constant step [fraction of Rs/Vs] without error control, for convergence studies.
-    branch_landing : bool
-        Step onto the surfaces where the force stops being smooth instead of across them
-        (default True; False only to measure what that saves).
+    err^(−1/5). Settings (:class:`EmbeddedRungeKutta`): ``rtol`` (default 1e-8: exit speed
+    within 2e-7 of the impact speed and exit obliquity within 1e-5° of the reference on
+    the benchmark set, docs/integrators.md), ``max_steps``, ``fixed_step``,
+    ``branch_landing``.
     """
 
     name = "dopri5"

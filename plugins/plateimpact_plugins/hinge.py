@@ -7,23 +7,30 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import ParameterError, ResistanceLaw, SceneBatch
+from plateimpact import BoundResistance, Column, Parameter, Range, SceneBatch
 
+from .plate_constants import CRITICAL_PENETRATION, FAILURE_ANGLE
 from .separation import PlaneSeparation
 
 HALF_PI = 0.5 * np.pi
 
-
-def _non_negative(instance: object, attribute: attrs.Attribute, value: float) -> None:
-    if not (isinstance(value, int | float) and np.isfinite(value) and value >= 0.0):
-        raise ParameterError(attribute.name, f"{attribute.name} must be >= 0, got {value!r}")
-
-
-def _hinge_obliquity(instance: object, attribute: attrs.Attribute, value: float | None) -> None:
-    if value is not None and not (isinstance(value, int | float) and 0.0 < value < HALF_PI):
-        raise ParameterError(
-            attribute.name, f"{attribute.name} must be in (0, 90) deg, got {value!r} rad"
-        )
+FINGER_AREA_SCALE = Parameter(
+    "finger_area_scale",
+    "multiplies the finger's presented area As (0: no finger, i.e. plugging)",
+    range=Range(0.0),
+    default=1.0,
+)
+HINGE_OBLIQUITY = Parameter(
+    "hinge_obliquity",
+    "theta1, the obliquity where the finger's force switches from eq 19 to eq 20 "
+    "(none: 90 deg - alpha* of each plate)",
+    "rad",
+    Range(0.0, HALF_PI, True, True),
+    "deg",
+    np.pi / 180,
+    default=None,
+    optional=True,
+)
 
 
 @final
@@ -62,15 +69,15 @@ class Hinge(PlaneSeparation):
     name = "hinge"
     state_names = ("finger_angle",)
     state_units = ("rad",)
+    plate_constants = (CRITICAL_PENETRATION, FAILURE_ANGLE)
+    columns = (
+        *PlaneSeparation.columns,
+        Column("theta1", "rad", "theta1 of eqs 19-20: where the finger's force switches"),
+        Column("hinge_opening", "rad", "90 deg - theta1"),
+    )
 
-    finger_area_scale: float = attrs.field(default=1.0, validator=_non_negative)
-    hinge_obliquity: float | None = attrs.field(default=None, validator=_hinge_obliquity)
-
-    def settings(self) -> dict[str, object]:
-        return {
-            "finger_area_scale": self.finger_area_scale,
-            "hinge_obliquity": self.hinge_obliquity,
-        }
+    finger_area_scale: float = FINGER_AREA_SCALE.field()
+    hinge_obliquity: float | None = HINGE_OBLIQUITY.field()
 
     def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
         return batch.critical_penetration
@@ -84,7 +91,7 @@ class Hinge(PlaneSeparation):
         else:
             theta1 = np.full(batch.size, self.hinge_obliquity)
             opening = HALF_PI - theta1
-        return {**super().prepare(batch), "hinge_obliquity": theta1, "hinge_opening": opening}
+        return {**super().prepare(batch), "theta1": theta1, "hinge_opening": opening}
 
     def initial_state(
         self,
@@ -94,7 +101,7 @@ class Hinge(PlaneSeparation):
         batch: SceneBatch,
     ) -> np.ndarray:
         full = 2.0 * batch.failure_angle
-        return (full - np.maximum(obliquity - batch.hinge_obliquity, 0.0))[np.newaxis]
+        return (full - np.maximum(obliquity - batch.theta1, 0.0))[np.newaxis]
 
     def state_rates(
         self,
@@ -106,7 +113,7 @@ class Hinge(PlaneSeparation):
         batch: SceneBatch,
     ) -> np.ndarray:
         finger_angle = state[0]
-        held = (obliquity <= batch.hinge_obliquity) & (finger_angle >= 2.0 * batch.failure_angle)
+        held = (obliquity <= batch.theta1) & (finger_angle >= 2.0 * batch.failure_angle)
         peeling = np.maximum(obliquity_rate + speed / batch.radius, 0.0)  # eq 18 per unit time
         return np.where(held | (finger_angle <= 0.0), 0.0, -peeling)[np.newaxis]
 
@@ -119,7 +126,7 @@ class Hinge(PlaneSeparation):
     ) -> np.ndarray:
         # Besides the relief's: θ − θ1 [rad], where ψ″ switches from eq 19 to eq 20 and β
         # starts to shrink, and β [rad], which stops the finger at 0.
-        finger_rows = np.stack([obliquity - batch.hinge_obliquity, state[0]])
+        finger_rows = np.stack([obliquity - batch.theta1, state[0]])
         return np.concatenate(
             [super().branch_margins(penetration, obliquity, state, batch), finger_rows]
         )
@@ -133,7 +140,7 @@ class Hinge(PlaneSeparation):
         the plate normal."""
         half_angle = 0.5 * np.maximum(finger_angle, 0.0)
         area = self.finger_area_scale * np.pi * (batch.radius * np.sin(half_angle)) ** 2
-        theta1 = batch.hinge_obliquity
+        theta1 = batch.theta1
         incidence = np.where(
             obliquity < theta1,
             obliquity + (batch.hinge_opening - half_angle),  # eq 19: 90° + θ − θ1 − β/2
@@ -148,9 +155,9 @@ class Hinge(PlaneSeparation):
         speed: np.ndarray,
         state: np.ndarray,
         batch: SceneBatch,
-        law: ResistanceLaw,
+        law: BoundResistance,
     ) -> tuple[np.ndarray, np.ndarray]:
         drag, lift = self.relief(penetration, obliquity, speed, batch, law)
         area, incidence = self.finger(obliquity, state[0], batch)
-        finger_force = area * law.stress(speed, incidence, batch)  # eq 16
+        finger_force = area * law.stress(speed, incidence)  # eq 16
         return drag + finger_force * np.cos(incidence), lift + finger_force * np.sin(incidence)

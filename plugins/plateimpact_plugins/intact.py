@@ -7,7 +7,7 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import FailureModel, ResistanceLaw, SceneBatch
+from plateimpact import BoundResistance, FailureModel, SceneBatch
 
 
 @final
@@ -31,7 +31,7 @@ class Intact(FailureModel):
         speed: np.ndarray,
         state: np.ndarray,
         batch: SceneBatch,
-        law: ResistanceLaw,
+        law: BoundResistance,
     ) -> tuple[np.ndarray, np.ndarray]:
         raise AssertionError("an intact plate has no failed scenes")  # onset is inf
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from plateimpact import SceneBatch
 
+from .plate_constants import CRITICAL_PENETRATION, FAILURE_ANGLE
 from .separation import PlaneSeparation
 
 
@@ -19,6 +20,7 @@ class Plugging(PlaneSeparation):
     of eq 8, relieving the material beyond it (see :class:`PlaneSeparation`)."""
 
     name = "plugging"
+    plate_constants = (CRITICAL_PENETRATION, FAILURE_ANGLE)
 
     def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
         return batch.critical_penetration

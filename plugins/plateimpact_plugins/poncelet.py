@@ -9,6 +9,8 @@ import numpy as np
 
 from plateimpact import ResistanceLaw, SceneBatch
 
+from .plate_constants import DENSITY_B, STRENGTH_A
+
 
 @final
 @attrs.frozen
@@ -20,6 +22,7 @@ class Poncelet(ResistanceLaw):
     """
 
     name = "poncelet"
+    plate_constants = (STRENGTH_A, DENSITY_B)
 
     def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
         normal_speed = speed * np.cos(incidence)

@@ -6,7 +6,9 @@ from abc import abstractmethod
 
 import numpy as np
 
-from plateimpact import FailureModel, ResistanceLaw, SceneBatch, contact_force, geometry
+from plateimpact import BoundResistance, Column, FailureModel, SceneBatch, geometry
+
+from .plate_constants import FAILURE_ANGLE
 
 
 class PlaneSeparation(FailureModel):
@@ -27,6 +29,9 @@ class PlaneSeparation(FailureModel):
     force (:meth:`force_change` of the hinge adds the finger).
     """
 
+    plate_constants = (FAILURE_ANGLE,)
+    columns = (Column("failure_plane_depth", "m", "depth h of the failure plane (eq 8)"),)
+
     @abstractmethod
     def onset_penetration(self, batch: SceneBatch) -> np.ndarray: ...
 
@@ -41,11 +46,11 @@ class PlaneSeparation(FailureModel):
         obliquity: np.ndarray,
         speed: np.ndarray,
         batch: SceneBatch,
-        law: ResistanceLaw,
+        law: BoundResistance,
     ) -> tuple[np.ndarray, np.ndarray]:
         """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""
         below_plane = penetration - batch.failure_plane_depth
-        relieved_drag, relieved_lift = contact_force(law, below_plane, obliquity, speed, batch)
+        relieved_drag, relieved_lift = law.contact_force(below_plane, obliquity, speed)
         return -relieved_drag, -relieved_lift
 
     def force_change(
@@ -55,7 +60,7 @@ class PlaneSeparation(FailureModel):
         speed: np.ndarray,
         state: np.ndarray,
         batch: SceneBatch,
-        law: ResistanceLaw,
+        law: BoundResistance,
     ) -> tuple[np.ndarray, np.ndarray]:
         return self.relief(penetration, obliquity, speed, batch, law)
 

@@ -11,7 +11,7 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import ParameterError, SceneBatch
+from plateimpact import Parameter, ParameterError, SceneBatch
 
 from .separation import PlaneSeparation
 
@@ -168,6 +168,17 @@ def _to_table(value: object) -> PstarTable:
     )
 
 
+PSTAR_TABLE = Parameter(
+    "table",
+    "P* by impact obliquity and speed: a PstarTable, its rows, or a CSV file with columns "
+    + ",".join(TABLE_COLUMNS),
+    default=None,
+    flag="--pstar-table",
+    convert=lambda value: _to_table(SAE1010_TABLE if value is None else value),
+    to_json=lambda table: [list(row) for row in table.rows()],
+)
+
+
 @final
 @attrs.frozen
 class VariablePstar(PlaneSeparation):
@@ -186,10 +197,7 @@ class VariablePstar(PlaneSeparation):
 
     name = "variable-pstar"
 
-    table: PstarTable = attrs.field(default=SAE1010_TABLE, converter=_to_table)
-
-    def settings(self) -> dict[str, object]:
-        return {"table": self.table.rows()}
+    table: PstarTable = PSTAR_TABLE.field()
 
     def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
         return self.table(batch.impact_obliquity, batch.impact_speed)

@@ -1,5 +1,5 @@
-"""Event location on the dense output of an accepted step: sampling, the first event,
-and the root finding (docs/integrators.md, "events are never stepped over")."""
+"""Event location on the dense output of accepted steps: sampling, the first event, and
+the root finding (docs/integrators.md, "events are never stepped over")."""
 
 from __future__ import annotations
 
@@ -7,61 +7,32 @@ from collections.abc import Callable
 
 import numpy as np
 
-from plateimpact import OBLIQUITY, ImpactModel, SceneBatch
+from .dense import DenseOutput
+from .dynamics import Dynamics
+from .model import OBLIQUITY
 
-#: Where, inside an accepted step, event functions are sampled (fractions of the step).
-#: Sampling between the ends catches a margin that crosses and re-crosses in one step.
-EVENT_SAMPLES = np.linspace(0.0, 1.0, 5)
 MAX_ROOT_ITERATIONS = 16  # Illinois converges superlinearly; more only chases rounding
 ROOT_TOLERANCE = 1e-13  # event time to this fraction of the step
 ROOT_RESOLUTION = 1e-10  # or a margin this small against its values at the samples
 
 
-def dense_state(y: np.ndarray, coefficients: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
-    """State at the fraction ``sigma`` of the step (one for all, or one per scene), shape
-    (d, n), from the dense output y + σ(c_0 + σ(c_1 + ...)) by Horner's rule."""
-    total = coefficients[-1] * sigma
-    for coefficient in coefficients[-2::-1]:
-        total = (total + coefficient) * sigma
-    return y + total
-
-
 def sample_step(
-    model: ImpactModel,
-    y0: np.ndarray,
-    y1: np.ndarray,
-    coefficients: np.ndarray,
-    failed: np.ndarray,
-    held: np.ndarray,
-    batch: SceneBatch,
+    dynamics: Dynamics, y0: np.ndarray, y1: np.ndarray, dense: DenseOutput, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The states at EVENT_SAMPLES of the step, shape (d, samples, m), and the event
-    margins there, shape (events, samples, m). The ends are the step's own states;
-    only the interior comes from the dense output. One margin call per sample, on
-    the batch as it is (no repeated copy of its columns)."""
-    samples = np.empty((y0.shape[0], EVENT_SAMPLES.size, y0.shape[1]))
+    """The states at the fractions ``at`` of the step (0 and 1 included), shape
+    (d, samples, m), and the event margins there, shape (events, samples, m). The ends are
+    the step's own states; only the interior comes from the dense output. One margin call
+    per sample, on the batch as it is (no repeated copy of its columns)."""
+    samples = np.empty((y0.shape[0], at.size, y0.shape[1]))
     samples[:, 0], samples[:, -1] = y0, y1
-    for j in range(1, EVENT_SAMPLES.size - 1):
-        samples[:, j] = dense_state(y0, coefficients, EVENT_SAMPLES[j])
-    margins = np.stack(
-        [
-            model.event_margins(samples[:, j], failed, held, batch)
-            for j in range(EVENT_SAMPLES.size)
-        ],
-        axis=1,
-    )
+    for j in range(1, at.size - 1):
+        samples[:, j] = dense(at[j])
+    margins = np.stack([dynamics.event_margins(samples[:, j]) for j in range(at.size)], axis=1)
     return samples, margins
 
 
 def first_event(
-    model: ImpactModel,
-    samples: np.ndarray,
-    margins: np.ndarray,
-    y0: np.ndarray,
-    coefficients: np.ndarray,
-    failed: np.ndarray,
-    held: np.ndarray,
-    batch: SceneBatch,
+    dynamics: Dynamics, samples: np.ndarray, margins: np.ndarray, dense: DenseOutput, at: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where in the step (σ, inf for none) the first event happens, which one (-1 for
     none), and where θ first crosses 90° upward (σ, inf for none).
@@ -71,14 +42,14 @@ def first_event(
     crest are refined together, in one root-finding loop over (scene, kind) pairs.
     Ties go to the lower event kind, as in :data:`EVENT_NAMES` order.
     """
-    m = y0.shape[1]
+    m = samples.shape[2]
     count = margins.shape[0]
     turning = samples[OBLIQUITY] - 0.5 * np.pi  # the crest's margin
     values = np.concatenate([margins, turning[np.newaxis]])  # (events + 1, s, m)
     bracket = (values[:, :-1] < 0.0) & (values[:, 1:] >= 0.0)
     has = bracket.any(axis=1)
     first = np.argmax(bracket, axis=1)  # (events + 1, m)
-    earliest = np.where(has[:count], first[:count], EVENT_SAMPLES.size).min(axis=0)
+    earliest = np.where(has[:count], first[:count], at.size).min(axis=0)
     candidate = has.copy()
     candidate[:count] &= first[:count] == earliest
     event_sigma, event_kind = np.full(m, np.inf), np.full(m, -1)
@@ -87,24 +58,20 @@ def first_event(
     if not rows.size:
         return event_sigma, event_kind, crest_sigma
     lo = first[kinds, rows]
-    pairs_failed, pairs_held, pairs_batch = failed[rows], held[rows], batch.take(rows)
+    pairs = dynamics.take(rows)
     pair = np.arange(rows.size)
 
     def margin(state: np.ndarray) -> np.ndarray:
         every = np.concatenate(
-            [
-                model.event_margins(state, pairs_failed, pairs_held, pairs_batch),
-                (state[OBLIQUITY] - 0.5 * np.pi)[np.newaxis],
-            ]
+            [pairs.event_margins(state), (state[OBLIQUITY] - 0.5 * np.pi)[np.newaxis]]
         )
         return every[kinds, pair]
 
     located = locate(
         margin,
-        y0[:, rows],
-        coefficients[:, :, rows],
-        EVENT_SAMPLES[lo],
-        EVENT_SAMPLES[lo + 1],
+        dense.take(rows),
+        at[lo],
+        at[lo + 1],
         values[kinds, lo, rows],
         values[kinds, lo + 1, rows],
     )
@@ -121,8 +88,7 @@ def first_event(
 
 def locate(
     margin: Callable[[np.ndarray], np.ndarray],
-    y0: np.ndarray,
-    coefficients: np.ndarray,
+    dense: DenseOutput,
     lo: np.ndarray,
     hi: np.ndarray,
     f_lo: np.ndarray,
@@ -135,8 +101,7 @@ def locate(
     bracket; bisection where a margin is not finite. Each row stops on its own, once
     its bracket is below ROOT_TOLERANCE of the step or its margin at hi is below
     ROOT_RESOLUTION of its values at the samples, so a scene's result never depends
-    on the other scenes of its batch. Measured on the 5,000-scene benchmark chunk:
-    4.7 iterations per call against 8.3 with neither rule.
+    on the other scenes of its batch (benchmarks/event_location.py counts iterations).
     """
     lo, hi, f_lo, f_hi = lo.copy(), hi.copy(), f_lo.copy(), f_hi.copy()
     resolved = ROOT_RESOLUTION * np.where(np.isfinite(f_lo), np.maximum(-f_lo, f_hi), f_hi)
@@ -158,7 +123,7 @@ def locate(
         # rather than fall back to bisection and creep up on it.
         inside = np.clip(secant, lo + 0.5 * ROOT_TOLERANCE, hi - 0.5 * ROOT_TOLERANCE)
         x = np.where(usable & np.isfinite(secant), inside, 0.5 * (lo + hi))
-        f = margin(dense_state(y0, coefficients, x))
+        f = margin(dense(x))
         after = (f >= 0.0) & open_
         before = ~(f >= 0.0) & open_
         f_lo = np.where(after & (side > 0), 0.5 * f_lo, f_lo)  # Illinois: an end kept

@@ -1,41 +1,22 @@
-"""Calibration of the Poncelet constants a and b from residual speeds at normal incidence.
-
-Three steps, after the report's eqs 40–49 (docs/calibration.md):
-
-* :func:`fit_dri` — the DRI (Recht–Ipson) fit Vr = R (Vs² − V0²)^½ (eq 40) by linear least
-  squares of Vr² on Vs² (eq 41, M = R², B = −R² V0²);
-* :func:`newton_fit` — the report's iteration: the model is run at normal incidence at the
-  shots' impact speeds, its residual speeds fitted the same way, and a, b corrected by 2×2
-  Newton steps on the differences in R and V0 (eqs 44–49), from the energy-balance start
-  of :func:`energy_balance_start` (our repair of eqs 42–43);
-* :func:`direct_fit` — a and b by bounded nonlinear least squares of the model's residual
-  speeds to the shots.
-
-P* and α* are fixed beforehand (from craters, as in the report). Every model evaluation
-is one batch through :meth:`Simulation.run_batch`.
-"""
+"""a and b fitted to residual speeds: the report's Newton iteration (eqs 44–49) and a
+direct least-squares fit."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 
 import attrs
 import numpy as np
-from scipy.integrate import quad
 from scipy.optimize import least_squares
 
-from .batch import SceneBatch
-from .bodies import Plate, Sphere
-from .errors import CalibrationError, ConvergenceError, ShotDataError
-from .geometry import contact_geometry
-from .presets import DEFAULT_SPHERE
-from .results import Outcome
-from .shots import Shots
-from .simulation import Simulation
+from ..bodies import Plate, Sphere
+from ..errors import CalibrationError, ConvergenceError
+from ..presets import DEFAULT_SPHERE
+from ..simulation import Simulation
+from ..storage.shots import Shots
+from .dri import DriFit, fit_dri
+from .start import energy_balance_start, fit_model_dri, model_residual_speeds, normal_shots
 
-#: Fewest perforating shots a DRI fit takes: two fix R and V0, a third leaves a residual.
-MIN_PERFORATIONS = 3
 #: Relative step of a and b for the finite differences of eqs 44–47 (and the direct fit).
 DIFFERENCE_STEP = 1e-3
 #: The Newton iteration stops when R and V0 of the model match the shots' to this
@@ -45,49 +26,8 @@ NEWTON_TOLERANCE = 1e-6
 MAX_NEWTON_ITERATIONS = 20
 #: Halvings of one Newton step that leaves a, b > 0 or the model's perforations.
 MAX_HALVINGS = 30
-#: Largest R the start takes: R >= 1 would need b <= 0 (docs/calibration.md).
-MAX_START_R = 0.99
 #: The direct fit keeps a and b within this factor of its start.
 DIRECT_BOUND_FACTOR = 1e3
-
-
-@attrs.frozen(eq=False)
-class DriFit:
-    """Least-squares fit of Vr = R (Vs² − V0²)^½ (eq 40) to perforating shots.
-
-    Attributes
-    ----------
-    R : float
-        [-]; the slope of Vr against Vs at high speed.
-    V0 : float
-        Ballistic limit [m/s].
-    R_stderr, V0_stderr : float
-        Standard errors [-], [m/s] (0 for exact DRI data).
-    covariance : numpy.ndarray
-        2×2 covariance of (R [-], V0 [m/s]).
-    impact_speed : numpy.ndarray
-        Vs of the perforating shots used [m/s].
-    residuals : numpy.ndarray
-        Measured minus fitted residual speed at those shots [m/s].
-    """
-
-    R: float
-    V0: float
-    R_stderr: float
-    V0_stderr: float
-    covariance: np.ndarray
-    impact_speed: np.ndarray
-    residuals: np.ndarray
-
-    @property
-    def rms_residual(self) -> float:
-        """Root mean square of :attr:`residuals` [m/s]."""
-        return float(np.sqrt(np.mean(self.residuals**2)))
-
-    def residual_speed(self, impact_speed: np.ndarray | float) -> np.ndarray:
-        """The fitted curve, eq 40 [m/s], 0 below the ballistic limit; ``impact_speed`` [m/s]."""
-        vs = np.asarray(impact_speed, dtype=float)
-        return self.R * np.sqrt(np.clip(vs**2 - self.V0**2, 0.0, None))
 
 
 @attrs.frozen(eq=False)
@@ -148,135 +88,6 @@ class CalibrationReport:
     direct: Calibration
 
 
-def fit_dri(impact_speed: np.ndarray, residual_speed: np.ndarray) -> DriFit:
-    """DRI fit (eqs 40–41) of the perforating shots among ``impact_speed``,
-    ``residual_speed`` [m/s]; shots with residual speed 0 are left out.
-
-    Raises :class:`CalibrationError` with fewer than three perforating shots or when the
-    fit has no ballistic limit (V0² <= 0) or R <= 0.
-    """
-    vs = np.asarray(impact_speed, dtype=float).reshape(-1)
-    vr = np.asarray(residual_speed, dtype=float).reshape(-1)
-    used = vr > 0.0
-    n = int(used.sum())
-    if n < MIN_PERFORATIONS:
-        raise CalibrationError(
-            f"the DRI fit needs at least {MIN_PERFORATIONS} perforating shots, got {n}"
-        )
-    vs, vr = vs[used], vr[used]
-    # Eq 41: Y = M X + B, X = Vs², Y = Vr²; X is scaled so the normal matrix is O(1).
-    scale = float(np.mean(vs**2))
-    design = np.column_stack([vs**2 / scale, np.ones(n)])
-    (slope, intercept), *_ = np.linalg.lstsq(design, vr**2, rcond=None)
-    M, B = slope / scale, intercept
-    if not M > 0.0:
-        raise CalibrationError(
-            f"the DRI fit has slope R^2 = {M:.4g} <= 0: residual speeds do not rise with "
-            "impact speed"
-        )
-    if not B < 0.0:
-        raise CalibrationError(
-            f"the DRI fit gives no ballistic limit (V0^2 = {-B / M:.4g} m^2/s^2 <= 0): "
-            "residual speeds do not fall to zero at any impact speed"
-        )
-    R, V0 = math.sqrt(M), math.sqrt(-B / M)
-    sum_squares = float(np.sum((vr**2 - design @ [slope, intercept]) ** 2))
-    cov_scaled = sum_squares / (n - 2) * np.linalg.inv(design.T @ design)
-    cov_MB = cov_scaled * np.outer([1 / scale, 1.0], [1 / scale, 1.0])
-    # Delta method: R = M^½, V0 = (−B/M)^½.
-    gradient = np.array([[1 / (2 * R), 0.0], [B / (2 * M**2 * V0), -1 / (2 * M * V0)]])
-    cov = gradient @ cov_MB @ gradient.T
-    residuals = vr - R * np.sqrt(np.clip(vs**2 - V0**2, 0.0, None))
-    return DriFit(R, V0, math.sqrt(cov[0, 0]), math.sqrt(cov[1, 1]), cov, vs.copy(), residuals)
-
-
-def swept_volume(sphere: Sphere, plate: Plate) -> float:
-    """W [m³]: the integral of the net presented area over the penetration at normal
-    incidence, from first contact to perforation, with plugging at P* (eq 8).
-
-    At θ = 0 the presented area is A(P) = π (2 Rs p − p²), p = min(P, Rs) (eqs 2–3); after
-    failure the part deeper than h = Rs cos α* + P* − Rs no longer resists (eqs 9–15), and
-    perforation is complete at P = h + Rs.
-    """
-    rs, pstar = sphere.radius, plate.critical_penetration
-    if not math.isfinite(pstar):
-        raise CalibrationError("a plate that never fails (P* = inf) cannot be perforated")
-
-    def area(p: float) -> float:  # A at θ = 0 from the core geometry: eqs 2–6 exist once
-        return float(contact_geometry(np.array([p]), np.zeros(1), np.array([rs]))[0][0])
-
-    def area_integral(lo: float, hi: float) -> float:  # ∫ A dP [m³]; A has a kink at Rs
-        if hi <= lo:
-            return 0.0
-        points = [rs] if lo < rs < hi else None
-        return quad(area, lo, hi, points=points, epsabs=0.0, epsrel=1e-13, limit=200)[0]
-
-    h = max(rs * math.cos(plate.failure_angle) + pstar - rs, 0.0)
-    end = max(h + rs, pstar)
-    # The intact area up to perforation, less the relieved area beyond the plane after P*.
-    return area_integral(0.0, end) - area_integral(max(pstar - h, 0.0), end - h)
-
-
-def energy_balance_start(
-    R: float, V0: float, sphere: Sphere, plate: Plate, *, volume: float | None = None
-) -> tuple[float, float]:
-    """Start values (a [N/m²], b [kg/m³]) of the Newton iteration from the shots' R [-]
-    and V0 [m/s] (our dimensionally consistent eqs 42–43, docs/calibration.md).
-
-    At normal incidence m V dV = −A (a + b V²) dP integrates to
-    a + b Vr² = (a + b Vs²) exp(−2 b W / m), W the swept volume [m³]: eq 40 exactly, with
-    R² = exp(−2 b W / m) and V0² = (a / b)(1/R² − 1). Inverted:
-    b = m ln(1/R) / W and a = b R² V0² / (1 − R²) (→ m V0² / 2W, the energy balance, as
-    b → 0). ``volume`` replaces W (e.g. π Rs² T, the thickness reading of eq 42).
-    R is capped at 0.99 so the start stays in a, b > 0.
-    """
-    volume = swept_volume(sphere, plate) if volume is None else volume
-    R = min(R, MAX_START_R)
-    b = sphere.mass * math.log(1.0 / R) / volume
-    return b * R**2 * V0**2 / (1.0 - R**2), b
-
-
-def model_residual_speeds(
-    simulation: Simulation,
-    sphere: Sphere,
-    plate: Plate,
-    impact_speeds: np.ndarray,
-    constants: Sequence[tuple[float, float]],
-) -> np.ndarray:
-    """Residual speeds [m/s] of the model at normal incidence, shape (len(constants),
-    len(impact_speeds)), for each (a [N/m²], b [kg/m³]) in ``constants``; one batch.
-    Embedments give 0."""
-    speeds = np.asarray(impact_speeds, dtype=float)
-    batch = SceneBatch.concat(
-        SceneBatch.grid(sphere, attrs.evolve(plate, a=a, b=b), speeds, np.zeros(1))
-        for a, b in constants
-    )
-    result = simulation.run_batch(batch)
-    residual = np.where(result.outcome == Outcome.PERFORATION, result.exit_speed, 0.0)
-    return residual.reshape(len(constants), speeds.size)
-
-
-def _normal_shots(shots: Shots) -> Shots:
-    """The shots at normal incidence, with at least three perforations (ShotDataError)."""
-    normal = shots.normal_incidence()
-    perforating = [label for label, p in zip(normal.labels, normal.perforated, strict=True) if p]
-    if len(perforating) < MIN_PERFORATIONS:
-        listed = f" ({', '.join(perforating)})" if perforating else ""
-        raise ShotDataError(
-            f"{shots.source}: {len(perforating)} perforating shots at normal incidence{listed}; "
-            f"the DRI fit needs at least {MIN_PERFORATIONS}"
-        )
-    return normal
-
-
-def _model_fit(speeds: np.ndarray, residual: np.ndarray) -> DriFit | None:
-    """The DRI fit of model output, or None where it is unusable (too few perforations)."""
-    try:
-        return fit_dri(speeds, residual)
-    except CalibrationError:
-        return None
-
-
 def newton_fit(
     shots: Shots,
     plate: Plate,
@@ -301,7 +112,7 @@ def newton_fit(
     :class:`ConvergenceError` after ``max_iterations`` steps.
     """
     simulation = simulation or Simulation.from_names()
-    normal = _normal_shots(shots)
+    normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds = normal.impact_speed
     a, b = start or energy_balance_start(target.R, target.V0, sphere, plate)
@@ -310,7 +121,7 @@ def newton_fit(
     def evaluate(a: float, b: float) -> tuple[np.ndarray, list[DriFit | None]]:
         constants = [(a, b), (a * (1 + step), b), (a, b * (1 + step))]
         residual = model_residual_speeds(simulation, sphere, plate, speeds, constants)
-        return residual, [_model_fit(speeds, r) for r in residual]
+        return residual, [fit_model_dri(speeds, r) for r in residual]
 
     residual, fits = evaluate(a, b)
     if any(f is None for f in fits):
@@ -399,7 +210,7 @@ def direct_fit(
     variance over the shots that carry one (those the data or the model perforates).
     """
     simulation = simulation or Simulation.from_names()
-    normal = _normal_shots(shots)
+    normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds, measured = normal.impact_speed, normal.residual_speed
     a0, b0 = start or energy_balance_start(target.R, target.V0, sphere, plate)
@@ -446,7 +257,7 @@ def direct_fit(
     variance = float(np.sum(solution.fun**2)) / dof if dof > 0 else math.nan
     cov = variance * np.linalg.inv(J.T @ J) * np.outer([a, b], [a, b])
     model = residuals(solution.x) + measured
-    model_fit = _model_fit(speeds, model)
+    model_fit = fit_model_dri(speeds, model)
     if model_fit is None:
         raise CalibrationError(
             "the direct fit's a, b perforate fewer than three of the shots' impact speeds"
@@ -497,7 +308,7 @@ def calibrate(
 ) -> CalibrationReport:
     """The DRI fit of ``shots`` and a, b by both methods (``plate``: T, P*, α*)."""
     simulation = simulation or Simulation.from_names()
-    normal = _normal_shots(shots)
+    normal = normal_shots(shots)
     options = {"sphere": sphere, "simulation": simulation}
     return CalibrationReport(
         shots=shots,

@@ -1,8 +1,4 @@
-"""``plateimpact calibrate``: a and b from shots at normal incidence (eqs 40–49).
-
-Registered into :mod:`plateimpact.cli` (which imports this module only when the command
-is built or run, so that this module may import the command line's helpers).
-"""
+"""``plateimpact calibrate``: a and b from shots at normal incidence (eqs 40–49)."""
 
 from __future__ import annotations
 
@@ -14,21 +10,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import __version__
-from .bodies import Plate, Sphere
-from .calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
-from .cli import (
-    _add_model_options,
-    _check_directory,
-    _save_figure_atomically,
-    _simulation,
-    _sphere,
-    _write_atomically,
-)
-from .plate_file import plate_file_text
-from .shots import Shots
-from .simulation import Simulation
-from .units import deg, g, mm
+from ..bodies import Plate, Sphere
+from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
+from ..registry import PluginRegistry
+from ..simulation import Simulation
+from ..storage.plate_file import plate_file_text
+from ..storage.provenance import versions
+from ..storage.shots import Shots
+from ..units import g, mm
+from .common import check_directory, save_figure_atomically, write_atomically
+from .options import add_body_options, add_model_options, bodies, model_choice
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -37,7 +28,7 @@ if TYPE_CHECKING:
 CURVE_POINTS = 150
 
 
-def add_calibrate_parser(sub: Any) -> None:
+def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     """Add the ``calibrate`` sub-command to the sub-parsers ``sub``."""
     p = sub.add_parser(
         "calibrate",
@@ -52,11 +43,6 @@ def add_calibrate_parser(sub: Any) -> None:
         help="columns impact_speed_m_s,impact_obliquity_deg,residual_speed_m_s"
         "[,exit_obliquity_deg,outcome] in any order; residual 0: no perforation",
     )
-    p.add_argument("--thickness", type=float, required=True, help="plate thickness T [mm]")
-    p.add_argument("--pstar", type=float, required=True, help="critical penetration P* [mm]")
-    p.add_argument("--alpha", type=float, required=True, help="failure angle alpha* [deg]")
-    p.add_argument("--radius", type=float, help="sphere radius Rs [mm] (default 3.175)")
-    p.add_argument("--mass", type=float, help="sphere mass m [g] (default 1.0498)")
     p.add_argument("--material", default="calibrated", help="material label of the plate")
     p.add_argument(
         "--method",
@@ -67,27 +53,33 @@ def add_calibrate_parser(sub: Any) -> None:
     p.add_argument("--out", metavar="PLATE.json", help="write the calibrated plate file here")
     p.add_argument("--png", metavar="FILE", help="draw data, DRI curve and model curves here")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    _add_model_options(p)
+    add_body_options(p, registry)
+    add_model_options(p, registry)
+    p.set_defaults(command_function=calibrate_command)
 
 
 def calibrate_command(args: argparse.Namespace) -> None:
     """Run ``plateimpact calibrate``."""
-    _check_directory(args.out, "--out")
-    _check_directory(args.png, "--png")
+    check_directory(args.out, "--out")
+    check_directory(args.png, "--png")
     shots = Shots.from_csv(args.shots)
-    sphere = _sphere(args)
-    # a and b of this plate are placeholders: the calibration replaces them.
-    plate = Plate(args.material, args.thickness * mm, 1.0, 1.0, args.pstar * mm, args.alpha * deg)
-    simulation = _simulation(args)
+    choice = model_choice(args)
+    simulation = choice.simulation()
+    # a and b are what the calibration finds: placeholders until then.
+    choice.plate.setdefault("a", 1.0)
+    choice.plate.setdefault("b", 1.0)
+    sphere, given, _ = bodies(args, choice, simulation.model)
+    plate = Plate(args.material, given.thickness, given.constants)
     report = calibrate(shots, plate, sphere=sphere, simulation=simulation)
     chosen = report.newton if args.method == "newton" else report.direct
     summary = _summary(args, report, chosen)
     summary["model"] = simulation.describe()
     if args.out is not None:
-        extra = {"calibration": {**_provenance(args, report, chosen), "model": summary["model"]}}
-        _write_atomically(args.out, plate_file_text(chosen.plate, extra), "--out")
+        provenance = _provenance(args, report, chosen, sphere)
+        extra = {"calibration": {**provenance, "model": summary["model"]}}
+        write_atomically(args.out, plate_file_text(chosen.plate, extra), "--out")
     if args.png is not None:
-        _save_figure_atomically(_figure(report, sphere, simulation), args.png)
+        save_figure_atomically(_figure(report, sphere, simulation), args.png)
     if args.json:
         print(json.dumps(summary))
     else:
@@ -140,9 +132,8 @@ def _summary(
 
 
 def _provenance(
-    args: argparse.Namespace, report: CalibrationReport, chosen: Calibration
+    args: argparse.Namespace, report: CalibrationReport, chosen: Calibration, sphere: Sphere
 ) -> dict[str, Any]:
-    sphere = _sphere(args)
     return {
         "method": chosen.method,
         "shots_file": os.path.basename(args.shots),
@@ -151,7 +142,7 @@ def _provenance(
         "R": report.dri.R,
         "V0_m_s": report.dri.V0,
         "sphere": {"radius_mm": sphere.radius / mm, "mass_g": sphere.mass / g},
-        "plateimpact_version": __version__,
+        "plateimpact_version": versions()["plateimpact"],
     }
 
 
@@ -197,7 +188,7 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
 
 def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
     """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
-    from . import plotting  # noqa: PLC0415
+    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
     normal = report.shots.normal_incidence()
     speeds = np.linspace(
@@ -207,7 +198,7 @@ def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -
     curves = model_residual_speeds(
         simulation, sphere, fits[0].plate, speeds, [(f.a, f.b) for f in fits]
     )
-    fig, ax = plotting.plt.subplots(figsize=(7, 5))
+    fig, ax = plotting.figure(figsize=(7, 5))
     plotting.plot_calibration(
         ax,
         normal,

@@ -22,12 +22,12 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
-from .batch import SceneBatch
-from .bodies import Plate, Sphere
-from .errors import ShotDataError
-from .results import Outcome
-from .simulation import Simulation
-from .units import deg
+from ..batch import SceneBatch
+from ..bodies import Plate, Sphere
+from ..errors import ShotDataError
+from ..results import Outcome
+from ..simulation import Simulation
+from ..units import deg
 
 REQUIRED_COLUMNS = ("impact_speed_m_s", "impact_obliquity_deg", "residual_speed_m_s")
 OPTIONAL_COLUMNS = ("exit_obliquity_deg", "outcome")

@@ -1,0 +1,111 @@
+"""Start values of a and b from the energy balance at normal incidence, and the model's
+residual speeds (eqs 42–43, our dimensionally consistent reading: docs/calibration.md)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import attrs
+import numpy as np
+from scipy.integrate import quad
+
+from ..batch import SceneBatch
+from ..bodies import Plate, Sphere
+from ..errors import CalibrationError, ShotDataError
+from ..geometry import contact_geometry
+from ..results import Outcome
+from ..simulation import Simulation
+from ..storage.shots import Shots
+from .dri import MIN_PERFORATIONS, DriFit, fit_dri
+
+#: Largest R the start takes: R >= 1 would need b <= 0 (docs/calibration.md).
+MAX_START_R = 0.99
+
+
+def swept_volume(sphere: Sphere, plate: Plate) -> float:
+    """W [m³]: the integral of the net presented area over the penetration at normal
+    incidence, from first contact to perforation, with plugging at P* (eq 8).
+
+    At θ = 0 the presented area is A(P) = π (2 Rs p − p²), p = min(P, Rs) (eqs 2–3); after
+    failure the part deeper than h = Rs cos α* + P* − Rs no longer resists (eqs 9–15), and
+    perforation is complete at P = h + Rs.
+    """
+    rs, pstar = sphere.radius, plate.critical_penetration
+    if not math.isfinite(pstar):
+        raise CalibrationError("a plate that never fails (P* = inf) cannot be perforated")
+
+    def area(p: float) -> float:  # A at θ = 0 from the core geometry: eqs 2–6 exist once
+        return float(contact_geometry(np.array([p]), np.zeros(1), np.array([rs]))[0][0])
+
+    def area_integral(lo: float, hi: float) -> float:  # ∫ A dP [m³]; A has a kink at Rs
+        if hi <= lo:
+            return 0.0
+        points = [rs] if lo < rs < hi else None
+        return quad(area, lo, hi, points=points, epsabs=0.0, epsrel=1e-13, limit=200)[0]
+
+    h = max(rs * math.cos(plate.failure_angle) + pstar - rs, 0.0)
+    end = max(h + rs, pstar)
+    # The intact area up to perforation, less the relieved area beyond the plane after P*.
+    return area_integral(0.0, end) - area_integral(max(pstar - h, 0.0), end - h)
+
+
+def energy_balance_start(
+    R: float, V0: float, sphere: Sphere, plate: Plate, *, volume: float | None = None
+) -> tuple[float, float]:
+    """Start values (a [N/m²], b [kg/m³]) of the Newton iteration from the shots' R [-]
+    and V0 [m/s] (our dimensionally consistent eqs 42–43, docs/calibration.md).
+
+    At normal incidence m V dV = −A (a + b V²) dP integrates to
+    a + b Vr² = (a + b Vs²) exp(−2 b W / m), W the swept volume [m³]: eq 40 exactly, with
+    R² = exp(−2 b W / m) and V0² = (a / b)(1/R² − 1). Inverted:
+    b = m ln(1/R) / W and a = b R² V0² / (1 − R²) (→ m V0² / 2W, the energy balance, as
+    b → 0). ``volume`` replaces W (e.g. π Rs² T, the thickness reading of eq 42).
+    R is capped at 0.99 so the start stays in a, b > 0.
+    """
+    volume = swept_volume(sphere, plate) if volume is None else volume
+    R = min(R, MAX_START_R)
+    b = sphere.mass * math.log(1.0 / R) / volume
+    return b * R**2 * V0**2 / (1.0 - R**2), b
+
+
+def model_residual_speeds(
+    simulation: Simulation,
+    sphere: Sphere,
+    plate: Plate,
+    impact_speeds: np.ndarray,
+    constants: Sequence[tuple[float, float]],
+) -> np.ndarray:
+    """Residual speeds [m/s] of the model at normal incidence, shape (len(constants),
+    len(impact_speeds)), for each (a [N/m²], b [kg/m³]) in ``constants``; one batch.
+    Embedments give 0."""
+    speeds = np.asarray(impact_speeds, dtype=float)
+    batch = SceneBatch.concat(
+        SceneBatch.grid(sphere, attrs.evolve(plate, a=a, b=b), speeds, np.zeros(1))
+        for a, b in constants
+    )
+    result = simulation.run_batch(batch)
+    residual = np.where(result.outcome == Outcome.PERFORATION, result.exit_speed, 0.0)
+    return residual.reshape(len(constants), speeds.size)
+
+
+def normal_shots(shots: Shots) -> Shots:
+    """The shots at normal incidence, with at least three perforations (ShotDataError)."""
+    normal = shots.normal_incidence()
+    perforating = [label for label, p in zip(normal.labels, normal.perforated, strict=True) if p]
+    if len(perforating) < MIN_PERFORATIONS:
+        listed = f" ({', '.join(perforating)})" if perforating else ""
+        raise ShotDataError(
+            f"{shots.source}: {len(perforating)} perforating shots at normal incidence{listed}; "
+            f"the DRI fit needs at least {MIN_PERFORATIONS}"
+        )
+    return normal
+
+
+def fit_model_dri(speeds: np.ndarray, residual: np.ndarray) -> DriFit | None:
+    """The DRI fit of model output, or None where it is unusable (too few perforations)."""
+    try:
+        return fit_dri(speeds, residual)
+    except CalibrationError:
+        return None
+

@@ -1,0 +1,86 @@
+"""``presets`` and ``plugins``: what is installed, with every fact from its declaration."""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+import json
+from typing import Any
+
+from .. import presets
+from ..bodies import MASS, RADIUS, THICKNESS
+from ..parameters import Parameter
+from ..registry import KINDS, PluginRegistry, default_registry
+
+
+def add_parsers(sub: Any) -> None:
+    p = sub.add_parser("presets", help="list the plate presets and the default sphere")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(command_function=presets_command)
+
+    p = sub.add_parser("plugins", help="list the installed plug-ins by kind")
+    p.add_argument(
+        "--details",
+        action="store_true",
+        help="each plug-in's settings and plate constants: unit, range, default, flag",
+    )
+    p.set_defaults(command_function=plugins_command)
+
+
+def _user_value(declared: Parameter, value: float) -> float:
+    return float(f"{value / declared.scale:.12g}")
+
+
+def presets_command(args: argparse.Namespace) -> None:
+    registry = default_registry()
+    declared = {THICKNESS.name: THICKNESS, **registry.plate_constants}
+    rows: dict[str, dict[str, Any]] = {}
+    for name, plate in presets.PLATES.items():
+        row: dict[str, Any] = {"material": plate.material}
+        for constant, value in [("thickness", plate.thickness), *plate.constants]:
+            row[declared[constant].key] = _user_value(declared[constant], value)
+        rows[name] = row
+    sphere = presets.DEFAULT_SPHERE
+    sphere_row = {
+        "material": "SAE 52100",
+        RADIUS.key: _user_value(RADIUS, sphere.radius),
+        MASS.key: _user_value(MASS, sphere.mass),
+        "density_kg_m3": presets.SAE_52100_DENSITY,
+    }
+    if args.json:
+        print(json.dumps({"plates": rows, "sphere": sphere_row}, indent=2))
+        return
+    keys = list(next(iter(rows.values())))[1:]
+    print(f"{'plate':14s} {'material':9s} " + " ".join(f"{k:>12s}" for k in keys))
+    for name, row in rows.items():
+        values = " ".join(f"{row[k]:12.4g}" for k in keys)
+        print(f"{name:14s} {row['material']:9s} {values}")
+    print(
+        f"\nsphere (default): SAE 52100, radius {sphere.radius * 1e3:.4g} mm, "
+        f"mass {sphere.mass * 1e3:.4f} g, density {presets.SAE_52100_DENSITY:.0f} kg/m^3"
+    )
+
+
+def _details(registry: PluginRegistry, kind: str, name: str) -> list[str]:
+    cls = registry.get(kind, name)
+    summary = (inspect.getdoc(cls) or "").split("\n")[0]
+    lines = [f"  {name} (version {cls.version}, {cls.__module__}): {summary}"]
+    for setting, declared in cls.setting_declarations().items():
+        alias = f", or {declared.flag}" if declared.flag else ""
+        lines.append(f"      --set {kind}.{setting}=VALUE{alias}: {declared.help()}")
+    for declared in cls.plate_constants:
+        alias = f", or {declared.flag}" if declared.flag else ""
+        lines.append(
+            f"      plate constant {declared.name} (plate file key {declared.key}{alias}): "
+            f"{declared.help()}"
+        )
+    return lines
+
+
+def plugins_command(args: argparse.Namespace) -> None:
+    registry = default_registry()
+    for kind in KINDS:
+        print(f"{kind}: {', '.join(registry.names(kind))}")
+        if args.details:
+            for name in registry.names(kind):
+                print("\n".join(_details(registry, kind, name)))

@@ -1,0 +1,253 @@
+"""The options every simulating command shares, derived from the declarations.
+
+Plate and sphere options come from the core's parameters (``--thickness``,
+``--radius``, ``--mass``) and from the plate constants the installed plug-ins declare
+(``--a``, ``--pstar``, ...); model options are the plug-in names and ``--set
+SLOT.NAME=VALUE`` for any setting or plate constant, with the flags a plug-in's settings
+declare (``--rtol``, ``--step``, ``--pstar-table``) as aliases. Help text, units, ranges
+and the flag an error names all come from the same declarations.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import attrs
+
+from .. import presets
+from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from ..model import REST_SPEED_FRACTION, ImpactModel
+from ..parameters import Parameter
+from ..registry import KINDS, PluginRegistry, default_registry
+from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from ..storage.plate_file import load_plate_file
+from .common import UsageError
+
+#: The model slots ``--set`` knows besides the plug-in kinds.
+SET_SLOTS = (*KINDS, "model", "plate")
+#: Which flag named which parameter, for error messages: set while arguments are read.
+TYPED_FLAGS = "_typed_flags"
+
+
+def _dest(flag: str) -> str:
+    return flag.lstrip("-").replace("-", "_")
+
+
+def _aliases(registry: PluginRegistry) -> dict[str, tuple[str, str, list[tuple[str, Parameter]]]]:
+    """Setting flags declared by plug-ins: flag -> (kind, setting, [(plug-in, declaration)])."""
+    found: dict[str, tuple[str, str, list[tuple[str, Parameter]]]] = {}
+    for kind in KINDS:
+        for name in registry.names(kind):
+            for setting, declared in registry.get(kind, name).setting_declarations().items():
+                if declared.flag:
+                    entry = found.setdefault(declared.flag, (kind, setting, []))
+                    entry[2].append((name, declared))
+    return found
+
+
+def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None:
+    """--resistance, --failure, --integrator, --set and the declared setting aliases."""
+    group = parser.add_argument_group("model (plug-ins by name; see 'plateimpact plugins --details')")
+    defaults = {
+        "resistance": DEFAULT_RESISTANCE,
+        "failure": DEFAULT_FAILURE,
+        "integrator": DEFAULT_INTEGRATOR,
+    }
+    for kind, default in defaults.items():
+        choices = ", ".join(registry.names(kind))
+        group.add_argument(f"--{kind}", default=default, help=f"{kind}: {choices} (default {default})")
+    group.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SLOT.NAME=VALUE",
+        help=f"a setting or plate constant, in the units 'plugins --details' lists; SLOT is "
+        f"one of {', '.join(SET_SLOTS)} (e.g. --set integrator.rtol=1e-9); repeatable",
+    )
+    for flag, (kind, setting, declarers) in sorted(_aliases(registry).items()):
+        owners = "; ".join(f"{name}: default {d.format(d.default)}" for name, d in declarers)
+        declared = declarers[0][1]
+        help_text = f"--set {kind}.{setting}=: {declared.description} ({owners})"
+        group.add_argument(flag, dest=_dest(flag), metavar=declared.user_unit.upper(), help=help_text)
+
+
+def add_body_options(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None:
+    """--preset, --plate-file, --thickness, every declared plate constant, --radius, --mass."""
+    group = parser.add_argument_group("plate and sphere (override the preset)")
+    group.add_argument("--preset", help=f"plate preset: {', '.join(presets.PLATES)}")
+    group.add_argument(
+        "--plate-file",
+        metavar="FILE",
+        help="plate from a plate file (JSON, e.g. written by 'plateimpact calibrate --out'); "
+        "not with --preset or the plate options",
+    )
+    for declared in (THICKNESS, *_constant_flags(registry).values()):
+        group.add_argument(
+            declared.flag,
+            dest=_dest(declared.flag or ""),
+            metavar=declared.user_unit.upper().replace("/", "_").replace("^", ""),
+            help=declared.help(),
+        )
+    sphere = presets.DEFAULT_SPHERE
+    group.add_argument("--radius", help=f"{RADIUS.help()} (default {sphere.radius * 1e3:.4g})")
+    group.add_argument("--mass", help=f"{MASS.help()} (default {sphere.mass * 1e3:.4f})")
+
+
+def _constant_flags(registry: PluginRegistry) -> dict[str, Parameter]:
+    """The registered plate constants that declare a flag, by name."""
+    return {name: p for name, p in registry.plate_constants.items() if p.flag}
+
+
+def typed(args: argparse.Namespace) -> dict[str, str]:
+    """Parameter name -> the flag the user typed for it (for error messages)."""
+    flags: dict[str, str] = getattr(args, TYPED_FLAGS, {})
+    setattr(args, TYPED_FLAGS, flags)
+    return flags
+
+
+def _parse(declared: Parameter, text: str, flag: str, args: argparse.Namespace) -> Any:
+    typed(args)[declared.name] = flag
+    return declared.parse(text)
+
+
+class ModelChoice:
+    """What the model options ask for: settings per slot and plate overrides [SI]."""
+
+    def __init__(self, args: argparse.Namespace, registry: PluginRegistry) -> None:
+        self.registry = registry
+        self.names = {kind: getattr(args, kind) for kind in KINDS}
+        self.settings: dict[str, dict[str, Any]] = {kind: {} for kind in KINDS}
+        self.model: dict[str, Any] = {}
+        self.plate: dict[str, float] = {}
+        self.plate_flags: dict[str, str] = {}
+        for flag, (kind, setting, _) in _aliases(registry).items():
+            value = getattr(args, _dest(flag), None)
+            if value is not None:
+                self._set(kind, setting, value, flag, args)
+        for item in args.set:
+            target, equals, value = item.partition("=")
+            slot, dot, name = target.strip().partition(".")
+            if not (equals and dot and name and slot in SET_SLOTS):
+                raise UsageError(
+                    f"--set: expected SLOT.NAME=VALUE with SLOT one of {', '.join(SET_SLOTS)}, "
+                    f"got {item!r}"
+                )
+            self._set(slot, name.strip(), value, f"--set {slot}.{name.strip()}", args)
+
+    def _set(self, slot: str, name: str, text: str, flag: str, args: argparse.Namespace) -> None:
+        if slot == "model":
+            if name != REST_SPEED_FRACTION.name:
+                raise UsageError(f"{flag}: the model's only setting is {REST_SPEED_FRACTION.name}")
+            self.model[name] = _parse(REST_SPEED_FRACTION, text, flag, args)
+            return
+        if slot == "plate":
+            declared = THICKNESS if name == "thickness" else self.registry.plate_constants.get(name)
+            if declared is None:
+                known = ", ".join(["thickness", *self.registry.plate_constants])
+                raise UsageError(f"{flag}: no plate constant {name!r}; plate constants: {known}")
+            self.plate[name] = _parse(declared, text, flag, args)
+            self.plate_flags[name] = flag
+            return
+        cls = self.registry.get(slot, self.names[slot])
+        settings = cls.setting_declarations()
+        constants = {p.name: p for p in cls.plate_constants}
+        if name in constants:
+            self.plate[name] = _parse(constants[name], text, flag, args)
+            self.plate_flags[name] = flag
+        elif name in settings:
+            self.settings[slot][name] = _parse(settings[name], text, flag, args)
+        else:
+            known = ", ".join(sorted([*settings, *constants])) or "none"
+            raise UsageError(
+                f"{flag}: {slot} {self.names[slot]!r} has no setting {name!r}; settings: {known}"
+            )
+
+    def simulation(self) -> Simulation:
+        """The model and integrator asked for."""
+        return Simulation.from_names(
+            self.names["resistance"],
+            self.names["failure"],
+            self.names["integrator"],
+            resistance_settings=self.settings["resistance"],
+            failure_settings=self.settings["failure"],
+            integrator_settings=self.settings["integrator"],
+            registry=self.registry,
+            **self.model,
+        )
+
+
+def model_choice(args: argparse.Namespace) -> ModelChoice:
+    return ModelChoice(args, default_registry())
+
+
+def sphere_of(args: argparse.Namespace) -> Sphere:
+    """The default sphere, or the one of --radius [mm] and --mass [g]."""
+    sphere = presets.DEFAULT_SPHERE
+    if args.radius is None and args.mass is None:
+        return sphere
+    radius = sphere.radius if args.radius is None else _parse(RADIUS, args.radius, "--radius", args)
+    if args.mass is not None:
+        return Sphere(radius=radius, mass=_parse(MASS, args.mass, "--mass", args))
+    return Sphere.of_density(radius, presets.SAE_52100_DENSITY)  # a new radius keeps the density
+
+
+def bodies(
+    args: argparse.Namespace, choice: ModelChoice, model: ImpactModel
+) -> tuple[Sphere, Plate, str]:
+    """Sphere, plate and its label from --preset / --plate-file / plate options and --set."""
+    overrides = dict(choice.plate)
+    flags = dict(choice.plate_flags)
+    for declared in (THICKNESS, *_constant_flags(choice.registry).values()):
+        text = getattr(args, _dest(declared.flag or ""), None)
+        if text is not None:
+            overrides[declared.name] = _parse(declared, text, declared.flag or "", args)
+            flags[declared.name] = declared.flag or ""
+    needed = model.plate_constants()
+    for name, flag in flags.items():
+        if name != "thickness" and name not in needed:
+            uses = ", ".join(needed) or "no plate constant"
+            raise UsageError(
+                f"{flag}: the model ({model.resistance.name} + {model.failure.name}) does not use "
+                f"{name}; it reads {uses}"
+            )
+    if args.plate_file is not None:
+        given = ["--preset"] * (args.preset is not None) + sorted(flags.values())
+        if given:
+            raise UsageError(f"--plate-file cannot be combined with {', '.join(given)}")
+        base, label = load_plate_file(args.plate_file, choice.registry), args.plate_file
+    elif args.preset is not None:
+        base, label = presets.plate(args.preset), args.preset
+    else:
+        required = [THICKNESS, *(p for p in needed.values() if not p.has_default)]
+        missing = [p.flag or f"--set plate.{p.name}" for p in required if p.name not in overrides]
+        if missing:
+            raise UsageError(
+                "--preset is required unless the plate options the model needs are given "
+                f"(missing {', '.join(missing)})"
+            )
+        thickness = overrides.pop("thickness")
+        return sphere_of(args), Plate("custom", thickness, overrides), "custom"
+    if "thickness" in overrides:
+        base = attrs.evolve(base, thickness=overrides.pop("thickness"))
+    if flags:
+        base = Plate(base.material, base.thickness, {**base.constant_values(), **overrides})
+        label = f"{label}+custom"
+    return sphere_of(args), base, label
+
+
+def scene_flags(args: argparse.Namespace, speed_flag: str, obliquity_flag: str) -> None:
+    """Name the flags that carried the impact speed and obliquity."""
+    typed(args).update({IMPACT_SPEED.name: speed_flag, IMPACT_OBLIQUITY.name: obliquity_flag})
+
+
+def flag_of(args: argparse.Namespace, parameter: str) -> str | None:
+    """The flag that set ``parameter``: as typed, or the one its declaration names."""
+    if parameter in typed(args):
+        return typed(args)[parameter]
+    registry = default_registry()
+    declared = {p.name: p for p in (THICKNESS, RADIUS, MASS)} | registry.plate_constants
+    if parameter in declared:
+        return declared[parameter].flag
+    return None

@@ -1,0 +1,184 @@
+"""``run``, ``crater`` and ``sweep``: scenes in user units, results in user units."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+import numpy as np
+
+from ..batch import SceneBatch
+from ..crater import crater_section
+from ..registry import PluginRegistry
+from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
+from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
+from .common import UsageError, check_directory, csv_text, save_figure_atomically, write_atomically
+from .options import add_body_options, add_model_options, bodies, model_choice, scene_flags, typed
+
+#: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
+SWEEP_COLUMNS = (
+    "preset",
+    IMPACT_SPEED.key,
+    IMPACT_OBLIQUITY.key,
+    *(RESULT_FIELDS[name].key for name in ("outcome", "exit_speed", "exit_obliquity")),
+    *(RESULT_FIELDS[name].key for name in ("contact_time", "max_penetration", "plate_failed")),
+)
+
+
+def add_parsers(sub: Any, registry: PluginRegistry) -> None:
+    p = sub.add_parser("run", help="run one scene")
+    p.add_argument("--speed", required=True, help=IMPACT_SPEED.help())
+    p.add_argument("--obliquity", required=True, help=IMPACT_OBLIQUITY.help())
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--trajectory", metavar="FILE", help="write the trajectory as CSV")
+    add_body_options(p, registry)
+    add_model_options(p, registry)
+    p.set_defaults(command_function=run_command)
+
+    p = sub.add_parser("crater", help="the crater section of one scene (eqs 31-39)")
+    p.add_argument("--speed", required=True, help=IMPACT_SPEED.help())
+    p.add_argument("--obliquity", required=True, help=IMPACT_OBLIQUITY.help())
+    p.add_argument("--csv", metavar="FILE", help="write lateral_mm,depth_mm here")
+    p.add_argument("--png", metavar="FILE", help="draw the crater here")
+    add_body_options(p, registry)
+    add_model_options(p, registry)
+    p.set_defaults(command_function=crater_command)
+
+    p = sub.add_parser("sweep", help="run a grid of speeds and obliquities")
+    p.add_argument("--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a comma list")
+    p.add_argument("--obliquities", required=True, help="impact obliquities [deg], a comma list")
+    p.add_argument("--csv", metavar="FILE", help="write CSV here (default: standard output)")
+    add_body_options(p, registry)
+    add_model_options(p, registry)
+    p.set_defaults(command_function=sweep_command)
+
+
+def _scene(args: argparse.Namespace) -> tuple[Scene, Any, str]:
+    """The scene, simulation and plate label of run and crater."""
+    scene_flags(args, "--speed", "--obliquity")
+    choice = model_choice(args)
+    simulation = choice.simulation()
+    sphere, plate, label = bodies(args, choice, simulation.model)
+    speed = IMPACT_SPEED.parse(args.speed)
+    obliquity = IMPACT_OBLIQUITY.parse(args.obliquity)
+    return Scene(sphere, plate, speed, obliquity), simulation, label
+
+
+def run_command(args: argparse.Namespace) -> None:
+    check_directory(args.trajectory, "--trajectory")
+    scene, simulation, label = _scene(args)
+    result = simulation.run(scene, record_trajectory=args.trajectory is not None)
+    if args.trajectory is not None and result.trajectory is not None:
+        path = result.trajectory
+        fields = list(TRAJECTORY_FIELDS.values())
+        rows = zip(*(getattr(path, f.name) / f.scale for f in fields), strict=True)
+        write_atomically(args.trajectory, csv_text([f.key for f in fields], rows), "--trajectory")
+    speed, obliquity = float(args.speed), float(args.obliquity)
+    out: dict[str, Any] = {"preset": label, IMPACT_SPEED.key: speed, IMPACT_OBLIQUITY.key: obliquity}
+    out.update(result.as_user_dict())
+    out["model"] = simulation.describe()
+    if args.json:
+        print(json.dumps(out))
+        return
+    print(f"{label}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
+    print(f"  exit speed       {result.exit_speed:.6g} m/s")
+    print(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
+    print(f"  contact time     {result.contact_time * 1e6:.6g} us")
+    print(f"  max penetration  {result.max_penetration * 1e3:.6g} mm")
+    if result.plate_failed:
+        print(
+            f"  plate failed     at P = {result.failure_penetration * 1e3:.6g} mm, "
+            f"Y = {result.failure_lateral * 1e3:.6g} mm, t = {result.failure_time * 1e6:.6g} us"
+        )
+    else:
+        print("  plate failed     no")
+
+
+def crater_command(args: argparse.Namespace) -> None:
+    check_directory(args.csv, "--csv")
+    check_directory(args.png, "--png")
+    scene, simulation, label = _scene(args)
+    result = simulation.run(scene, record_trajectory=True)
+    assert result.trajectory is not None
+    section = crater_section(result.trajectory, scene.sphere.radius, thickness=scene.plate.thickness)
+    print(
+        f"{label}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
+        f"{result.outcome.label}; crater {section.length * 1e3:.4g} mm long, "
+        f"{section.max_depth * 1e3:.4g} mm deep"
+    )
+    if args.csv is not None:
+        lateral, depth = CRATER_FIELDS["lateral"], CRATER_FIELDS["depth"]
+        rows = zip(section.lateral / lateral.scale, section.depth / depth.scale, strict=True)
+        write_atomically(args.csv, csv_text([lateral.key, depth.key], rows), "--csv")
+    if args.png is not None:
+        from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+
+        fig, ax = plotting.figure(figsize=(8, 4))
+        plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
+        ax.set_title(
+            f"{label}, {float(args.speed):g} m/s at {float(args.obliquity):g}°: {result.outcome.label}"
+        )
+        save_figure_atomically(fig, args.png)
+
+
+def _parse_speeds(text: str) -> np.ndarray:
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if n < 1:
+                raise ValueError
+            return np.linspace(float(start), float(stop), n)
+        return np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        raise UsageError(
+            f"--speeds must be START:STOP:N (N >= 1) or a comma list in m/s, got {text!r}"
+        ) from None
+
+
+def _parse_obliquities(text: str) -> np.ndarray:
+    try:
+        return np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        raise UsageError(f"--obliquities must be a comma list in degrees, got {text!r}") from None
+
+
+def sweep_command(args: argparse.Namespace) -> None:
+    check_directory(args.csv, "--csv")
+    scene_flags(args, "--speeds", "--obliquities")
+    choice = model_choice(args)
+    simulation = choice.simulation()
+    sphere, plate, label = bodies(args, choice, simulation.model)
+    speeds, obliquities = _parse_speeds(args.speeds), _parse_obliquities(args.obliquities)
+    typed(args)
+    batch = SceneBatch.grid(sphere, plate, speeds, obliquities * IMPACT_OBLIQUITY.scale)
+    result = simulation.run_batch(batch)
+    # Echo the values as typed (the grid is obliquity-major), not their round trip via SI.
+    typed_obliquity = np.repeat(obliquities, speeds.size)
+    typed_speed = np.tile(speeds, obliquities.size)
+    rows = (
+        [
+            label,
+            float(typed_speed[i]),
+            float(typed_obliquity[i]),
+            Outcome(int(result.outcome[i])).label,
+            float(result.exit_speed[i]),
+            float(result.exit_obliquity[i] / RESULT_FIELDS["exit_obliquity"].scale),
+            float(result.contact_time[i]),
+            float(result.max_penetration[i] / RESULT_FIELDS["max_penetration"].scale),
+            bool(result.plate_failed[i]),
+        ]
+        for i in range(len(result))
+    )
+    text = csv_text(SWEEP_COLUMNS, rows)
+    if args.csv is None:
+        sys.stdout.write(text)
+        return
+    write_atomically(args.csv, text, "--csv")
+    counts = np.bincount(result.outcome, minlength=4)
+    print(
+        f"wrote {len(result)} scenes to {args.csv}: "
+        + ", ".join(f"{counts[o]} {o.label}" for o in Outcome)
+    )

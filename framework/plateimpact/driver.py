@@ -1,0 +1,184 @@
+"""The one integration driver: every integrator's scenes go through this loop.
+
+The driver owns what all integrators share (the scipy ``solve_ivp`` / diffrax split):
+binding the batch, step-size control, the events and their order (one definition, the
+model's event margins), failure onset, the θ = π hold, rest, the maximum penetration,
+recording, and dropping finished scenes. The integrator only steps
+(:class:`~plateimpact.integrator.Integrator`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .batch import SceneBatch
+from .binding import BoundBatch
+from .control import StepSizes
+from .dynamics import Dynamics
+from .errors import IntegrationError
+from .events import first_event, sample_step
+from .integrator import Integrator, StepperState
+from .model import (
+    EVENT_OUTCOMES,
+    KINEMATIC_STATE,
+    LATERAL,
+    OBLIQUITY,
+    ONSET,
+    PENETRATION,
+    SPEED,
+    TURNED_BACK,
+    ImpactModel,
+)
+from .recorder import ResultRecorder
+from .results import BatchResult, Outcome
+
+
+def integrate(
+    model: ImpactModel,
+    integrator: Integrator,
+    batch: SceneBatch,
+    *,
+    record_trajectory: bool = False,
+) -> BatchResult:
+    """Integrate every scene of ``batch`` from first contact, (P, Y, θ, V) = (0, 0, θs,
+    Vs), to its outcome."""
+    recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
+    if batch.size:
+        _integrate(model, integrator, model.bind(batch), recorder)
+    return recorder.result()
+
+
+def _select(accepted: np.ndarray, new: StepperState, old: StepperState) -> StepperState:
+    """The carried state: the new one where the step was accepted."""
+    return {key: np.where(accepted, new[key], old[key]) for key in old}
+
+
+def _integrate(
+    model: ImpactModel, integrator: Integrator, batch: BoundBatch, recorder: ResultRecorder
+) -> None:
+    n = batch.size
+    width = KINEMATIC_STATE + len(model.failure.state_names)
+    scene = np.arange(n)
+    y = np.zeros((width, n))  # failure state integrates zeros until onset sets it
+    y[OBLIQUITY], y[SPEED] = batch.core.impact_obliquity, batch.core.impact_speed
+    t = np.zeros(n)
+    failed, held = np.zeros(n, bool), np.zeros(n, bool)
+    max_pen = np.zeros(n)
+    stats = recorder.stats
+    dynamics = Dynamics(model, batch, failed, held, stats)
+    sizes = StepSizes(
+        integrator.step_control(),
+        integrator.initial_step(dynamics),
+        dynamics.component_scale(width),
+        dynamics.time_scale,
+    )
+    state = integrator.start(dynamics, t, y)
+    at = np.linspace(0.0, 1.0, integrator.event_samples)
+    recorder.sample(scene, t, *y[:KINEMATIC_STATE], y[KINEMATIC_STATE:], failed)
+
+    for _ in range(integrator.max_steps):
+        stats["steps"] += 1
+        step = integrator.advance(dynamics, t, y, sizes.propose(dynamics, y, state), state)
+        ok = sizes.judge(step, y)
+        accepted = int(np.count_nonzero(ok))
+        stats["accepted_steps"] += accepted
+        stats["rejected_steps"] += ok.size - accepted
+        if not accepted:
+            continue
+        state = _select(ok, step.state, state)
+
+        # Accepted scenes: sample the step, find the first event in it.
+        idx = np.flatnonzero(ok)
+        here = dynamics if accepted == ok.size else dynamics.take(idx)
+        y0, h0, dense = y[:, idx], step.h[idx], step.dense.take(idx)
+        samples, margins = sample_step(here, y0, step.y[:, idx], dense, at)
+        event_sigma, event_kind, crest_sigma = first_event(here, samples, margins, dense, at)
+        hit = np.isfinite(event_sigma)
+        end_sigma = np.where(hit, event_sigma, 1.0)
+        y_end = np.where(hit, dense(end_sigma), step.y[:, idx])
+        t_end = t[idx] + end_sigma * h0
+
+        # Maximum penetration: P at the samples, at the step's end, and where θ
+        # crosses 90° upward (the crest) if that comes before the end.
+        inside = at[:, np.newaxis] <= end_sigma
+        peak = np.max(np.where(inside, samples[PENETRATION], -np.inf), axis=0)
+        peak = np.maximum(peak, y_end[PENETRATION])
+        crest_rows = np.flatnonzero(crest_sigma < end_sigma)
+        if crest_rows.size:
+            crest = dense.take(crest_rows)(crest_sigma[crest_rows])
+            peak[crest_rows] = np.maximum(peak[crest_rows], crest[PENETRATION])
+            if recorder.record_trajectory:  # the deepest point belongs to the path
+                at_crest = idx[crest_rows]
+                recorder.sample(
+                    scene[at_crest],
+                    t[at_crest] + crest_sigma[crest_rows] * h0[crest_rows],
+                    *crest[:KINEMATIC_STATE],
+                    crest[KINEMATIC_STATE:],
+                    failed[at_crest],
+                )
+        max_pen[idx] = np.maximum(max_pen[idx], peak)
+        if recorder.record_trajectory:
+            for j in range(1, at.size):
+                keep = at[j] < end_sigma
+                if keep.any():
+                    s_y = samples[:, j, keep]
+                    recorder.sample(
+                        scene[idx[keep]],
+                        t[idx[keep]] + at[j] * h0[keep],
+                        *s_y[:KINEMATIC_STATE],
+                        s_y[KINEMATIC_STATE:],
+                        failed[idx[keep]],
+                    )
+
+        # Advance; cut steps end at their event.
+        y[:, idx], t[idx] = y_end, t_end
+        status = np.zeros(y.shape[1], dtype=np.int8)
+        events = idx[hit]
+        kinds = event_kind[hit]
+        for kind, outcome in EVENT_OUTCOMES.items():
+            status[events[kinds == kind]] = outcome
+        onset = events[kinds == ONSET]
+        if onset.size:
+            mask = np.zeros(y.shape[1], bool)
+            mask[onset] = True
+            failed = failed | mask
+            failure_state = y[KINEMATIC_STATE:]
+            model.start_failure(
+                mask, y[PENETRATION], y[OBLIQUITY], y[SPEED], failure_state, batch
+            )
+            y[KINEMATIC_STATE:] = failure_state
+            recorder.failed(scene[onset], t[onset], y[PENETRATION, onset], y[LATERAL, onset])
+        if recorder.record_trajectory:  # the step's end; where the plate failed, its state
+            y_end = y[:, idx]
+            recorder.sample(
+                scene[idx], t_end, *y_end[:KINEMATIC_STATE], y_end[KINEMATIC_STATE:], failed[idx]
+            )
+        turned = events[kinds == TURNED_BACK]
+        if turned.size:
+            held[turned] = True
+            y[OBLIQUITY, turned] = ImpactModel.MAX_OBLIQUITY
+        dynamics = Dynamics(model, batch, failed, held, stats)
+        restart = events[(kinds == ONSET) | (kinds == TURNED_BACK)]
+        if restart.size:  # a new right-hand side from here: the stepper starts afresh
+            state = integrator.restart(dynamics, t, y, state, restart)
+
+        done = status > 0
+        if done.any():
+            exit_speed = np.where(status[done] == Outcome.EMBEDMENT, 0.0, y[SPEED, done])
+            recorder.finish(
+                scene[done], status[done], exit_speed, y[OBLIQUITY, done], t[done], max_pen[done]
+            )
+            keep = ~done
+            if not keep.any():
+                return
+            scene, batch = scene[keep], batch.take(keep)
+            y, t, max_pen = y[:, keep], t[keep], max_pen[keep]
+            failed, held = failed[keep], held[keep]
+            state = {key: values[..., keep] for key, values in state.items()}
+            sizes.take(keep)
+            dynamics = Dynamics(model, batch, failed, held, stats)
+    raise IntegrationError(
+        f"{integrator.name}: {scene.size} scene(s) unfinished after max_steps="
+        f"{integrator.max_steps} steps (first: scene {int(scene[0])}); raise max_steps "
+        "(--set integrator.max_steps=N)"
+    )

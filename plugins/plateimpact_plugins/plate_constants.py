@@ -1,0 +1,46 @@
+"""The report's plate constants (Table 1), declared by the built-ins that use them.
+
+A third-party plug-in that reads one of them declares the same object (importing it from
+here), so that every plug-in means the same thing by ``a`` or ``critical_penetration``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from plateimpact import Parameter, Range
+
+STRENGTH_A = Parameter(
+    "a",
+    "Poncelet strength term a (eq 1)",
+    "N/m^2",
+    Range(0.0, low_open=True),
+    flag="--a",
+)
+DENSITY_B = Parameter(
+    "b",
+    "Poncelet inertial term b (eq 1)",
+    "kg/m^3",
+    Range(0.0),
+    flag="--b",
+)
+CRITICAL_PENETRATION = Parameter(
+    "critical_penetration",
+    "critical penetration P*: the plate fails when the penetration reaches it (inf: never)",
+    "m",
+    Range(0.0, low_open=True, allow_inf=True),
+    "mm",
+    1e-3,
+    flag="--pstar",
+    short="pstar",
+)
+FAILURE_ANGLE = Parameter(
+    "failure_angle",
+    "failure angle alpha*: where the failure ring sits on the sphere, from the plate normal",
+    "rad",
+    Range(0.0, math.pi / 2, True, True),
+    "deg",
+    math.pi / 180,
+    flag="--alpha",
+    short="alpha",
+)
