@@ -75,6 +75,9 @@ def _integrate(
     state = integrator.start(dynamics, t, y)
     at = np.linspace(0.0, 1.0, integrator.event_samples)
     recorder.sample(scene, t, *y[:KINEMATIC_STATE], y[KINEMATIC_STATE:], failed)
+    # The event margins at each scene's current state, where known: a step's end is the
+    # next step's start unless an event changed the scene.
+    margins_now, known = np.empty((5, n)), np.zeros(n, bool)
 
     for _ in range(integrator.max_steps):
         stats["steps"] += 1
@@ -89,14 +92,21 @@ def _integrate(
 
         # Accepted scenes: sample the step, find the first event in it.
         idx = np.flatnonzero(ok)
-        here = dynamics if accepted == ok.size else dynamics.take(idx)
-        y0, h0, dense = y[:, idx], step.h[idx], step.dense.take(idx)
-        samples, margins = sample_step(here, y0, step.y[:, idx], dense, at)
+        every = accepted == ok.size  # then whole arrays, not copies, stand for the subset
+        sel: slice | np.ndarray = slice(None) if every else idx
+        here = dynamics if every else dynamics.take(idx)
+        y0, y1, h0 = y[:, sel], step.y[:, sel], step.h[sel]
+        dense = step.dense if every else step.dense.take(idx)
+        margins0 = margins_now[:, sel] if known[sel].all() else None
+        samples, margins = sample_step(here, y0, y1, dense, at, margins0)
         event_sigma, event_kind, crest_sigma = first_event(here, samples, margins, dense, at)
         hit = np.isfinite(event_sigma)
         end_sigma = np.where(hit, event_sigma, 1.0)
-        y_end = np.where(hit, dense(end_sigma), step.y[:, idx])
-        t_end = t[idx] + end_sigma * h0
+        y_end = y1.copy()
+        if hit.any():  # cut at the event, on the dense output
+            cut = np.flatnonzero(hit)
+            y_end[:, cut] = dense.take(cut)(end_sigma[cut])
+        t_end = t[sel] + end_sigma * h0
 
         # Maximum penetration: P at the samples, at the step's end, and where θ
         # crosses 90° upward (the crest) if that comes before the end.
@@ -116,7 +126,7 @@ def _integrate(
                     crest[KINEMATIC_STATE:],
                     failed[at_crest],
                 )
-        max_pen[idx] = np.maximum(max_pen[idx], peak)
+        max_pen[sel] = np.maximum(max_pen[sel], peak)
         if recorder.record_trajectory:
             for j in range(1, at.size):
                 keep = at[j] < end_sigma
@@ -131,7 +141,8 @@ def _integrate(
                     )
 
         # Advance; cut steps end at their event.
-        y[:, idx], t[idx] = y_end, t_end
+        y[:, sel], t[sel] = y_end, t_end
+        margins_now[:, sel], known[sel] = margins[:, -1], ~hit
         status = np.zeros(y.shape[1], dtype=np.int8)
         events = idx[hit]
         kinds = event_kind[hit]
@@ -149,9 +160,9 @@ def _integrate(
             y[KINEMATIC_STATE:] = failure_state
             recorder.failed(scene[onset], t[onset], y[PENETRATION, onset], y[LATERAL, onset])
         if recorder.record_trajectory:  # the step's end; where the plate failed, its state
-            y_end = y[:, idx]
+            y_end = y[:, sel]
             recorder.sample(
-                scene[idx], t_end, *y_end[:KINEMATIC_STATE], y_end[KINEMATIC_STATE:], failed[idx]
+                scene[sel], t_end, *y_end[:KINEMATIC_STATE], y_end[KINEMATIC_STATE:], failed[sel]
             )
         turned = events[kinds == TURNED_BACK]
         if turned.size:
@@ -174,6 +185,7 @@ def _integrate(
             scene, batch = scene[keep], batch.take(keep)
             y, t, max_pen = y[:, keep], t[keep], max_pen[keep]
             failed, held = failed[keep], held[keep]
+            margins_now, known = margins_now[:, keep], known[keep]
             state = {key: values[..., keep] for key, values in state.items()}
             sizes.take(keep)
             dynamics = Dynamics(model, batch, failed, held, stats)

@@ -63,9 +63,10 @@ class Dynamics:
         self.stats["force_evaluations"] += y.shape[1]
         return self.model.rates(y, self.failed, self.held, self.batch)
 
-    def event_margins(self, y: np.ndarray) -> np.ndarray:
-        """The event margins (:meth:`ImpactModel.event_margins`), shape (5, n)."""
-        return self.model.event_margins(y, self.failed, self.held, self.batch)
+    def event_margins(self, y: np.ndarray, kinds: frozenset[int] | None = None) -> np.ndarray:
+        """The event margins (:meth:`ImpactModel.event_margins`), shape (5, n); only the
+        rows ``kinds`` if given."""
+        return self.model.event_margins(y, self.failed, self.held, self.batch, kinds)
 
     def branch_margins(self, y: np.ndarray) -> np.ndarray:
         """The branch surfaces of the force (:meth:`ImpactModel.branch_margins`)."""

@@ -17,17 +17,28 @@ ROOT_RESOLUTION = 1e-10  # or a margin this small against its values at the samp
 
 
 def sample_step(
-    dynamics: Dynamics, y0: np.ndarray, y1: np.ndarray, dense: DenseOutput, at: np.ndarray
+    dynamics: Dynamics,
+    y0: np.ndarray,
+    y1: np.ndarray,
+    dense: DenseOutput,
+    at: np.ndarray,
+    margins0: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The states at the fractions ``at`` of the step (0 and 1 included), shape
     (d, samples, m), and the event margins there, shape (events, samples, m). The ends are
     the step's own states; only the interior comes from the dense output. One margin call
-    per sample, on the batch as it is (no repeated copy of its columns)."""
+    per sample, on the batch as it is (no repeated copy of its columns); ``margins0``, the
+    margins at the start if already known (the end of the previous step), saves one."""
     samples = np.empty((y0.shape[0], at.size, y0.shape[1]))
     samples[:, 0], samples[:, -1] = y0, y1
     for j in range(1, at.size - 1):
         samples[:, j] = dense(at[j])
-    margins = np.stack([dynamics.event_margins(samples[:, j]) for j in range(at.size)], axis=1)
+    margins = np.empty((5, at.size, y0.shape[1]))
+    for j in range(at.size):
+        if j == 0 and margins0 is not None:
+            margins[:, 0] = margins0
+        else:
+            margins[:, j] = dynamics.event_margins(samples[:, j])
     return samples, margins
 
 
@@ -44,16 +55,20 @@ def first_event(
     """
     m = samples.shape[2]
     count = margins.shape[0]
+    event_sigma, event_kind = np.full(m, np.inf), np.full(m, -1)
+    crest_sigma = np.full(m, np.inf)
     turning = samples[OBLIQUITY] - 0.5 * np.pi  # the crest's margin
+    cresting = (turning[:-1] < 0.0) & (turning[1:] >= 0.0)
+    if margins[:, 1:].max() < 0.0 and not cresting.any():
+        return event_sigma, event_kind, crest_sigma  # nothing reaches zero: the usual step
+    crossing = (margins[:, :-1] < 0.0) & (margins[:, 1:] >= 0.0)
     values = np.concatenate([margins, turning[np.newaxis]])  # (events + 1, s, m)
-    bracket = (values[:, :-1] < 0.0) & (values[:, 1:] >= 0.0)
+    bracket = np.concatenate([crossing, cresting[np.newaxis]])
     has = bracket.any(axis=1)
     first = np.argmax(bracket, axis=1)  # (events + 1, m)
     earliest = np.where(has[:count], first[:count], at.size).min(axis=0)
     candidate = has.copy()
     candidate[:count] &= first[:count] == earliest
-    event_sigma, event_kind = np.full(m, np.inf), np.full(m, -1)
-    crest_sigma = np.full(m, np.inf)
     kinds, rows = np.nonzero(candidate)
     if not rows.size:
         return event_sigma, event_kind, crest_sigma
@@ -61,9 +76,11 @@ def first_event(
     pairs = dynamics.take(rows)
     pair = np.arange(rows.size)
 
+    needed = frozenset(int(k) for k in np.unique(kinds) if k < count)
+
     def margin(state: np.ndarray) -> np.ndarray:
         every = np.concatenate(
-            [pairs.event_margins(state), (state[OBLIQUITY] - 0.5 * np.pi)[np.newaxis]]
+            [pairs.event_margins(state, needed), (state[OBLIQUITY] - 0.5 * np.pi)[np.newaxis]]
         )
         return every[kinds, pair]
 

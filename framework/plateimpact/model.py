@@ -238,7 +238,12 @@ class ImpactModel:
     # -- events ------------------------------------------------------------------------
 
     def event_margins(
-        self, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: BoundBatch
+        self,
+        y: np.ndarray,
+        failed: np.ndarray,
+        held: np.ndarray,
+        batch: BoundBatch,
+        kinds: frozenset[int] | None = None,
     ) -> np.ndarray:
         """Event functions, shape (5, n), rows :data:`ONSET` ... :data:`TURNED_BACK`: the
         one definition of the outcome rules.
@@ -248,26 +253,25 @@ class ImpactModel:
         (the failure model's margin, failed plates, while θ < π/2), rest (V_rest − V),
         turned back (θ − π + TURN_BACK_TOLERANCE, not yet held). Where two are reached at
         one point, the lower row wins: perforation over ricochet over embedment.
+        ``kinds``: compute only these rows (the others are NaN), as root finding needs.
         """
-        return np.stack([self.event_margin(k, y, failed, held, batch) for k in range(5)])
-
-    def event_margin(
-        self, kind: int, y: np.ndarray, failed: np.ndarray, held: np.ndarray, batch: BoundBatch
-    ) -> np.ndarray:
-        """One row of :meth:`event_margins`."""
         pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
         core = batch.core
-        if kind == ONSET:
-            return np.where(failed, -np.inf, pen - core.onset_penetration)
-        if kind == CONTACT_LOST:
-            return contact_lost_margin(pen, obl, core.radius)
-        if kind == PERFORATED:
-            return self._inward_perforation_margin(pen, obl, failed, batch)
-        if kind == AT_REST:
-            return core.rest_speed - y[SPEED]
-        if kind == TURNED_BACK:
-            return np.where(held, -np.inf, obl - (self.MAX_OBLIQUITY - self.TURN_BACK_TOLERANCE))
-        raise ValueError(f"no event {kind}")
+        every = kinds is None
+        margins = np.full((5, pen.size), np.nan) if not every else np.empty((5, pen.size))
+        if every or ONSET in kinds:  # type: ignore[operator]
+            margins[ONSET] = np.where(failed, -np.inf, pen - core.onset_penetration)
+        if every or CONTACT_LOST in kinds:  # type: ignore[operator]
+            margins[CONTACT_LOST] = contact_lost_margin(pen, obl, core.radius)
+        if every or PERFORATED in kinds:  # type: ignore[operator]
+            margins[PERFORATED] = self._inward_perforation_margin(pen, obl, failed, batch)
+        if every or AT_REST in kinds:  # type: ignore[operator]
+            margins[AT_REST] = core.rest_speed - y[SPEED]
+        if every or TURNED_BACK in kinds:  # type: ignore[operator]
+            margins[TURNED_BACK] = np.where(
+                held, -np.inf, obl - (self.MAX_OBLIQUITY - self.TURN_BACK_TOLERANCE)
+            )
+        return margins
 
     def branch_margins(self, y: np.ndarray, failed: np.ndarray, batch: BoundBatch) -> np.ndarray:
         """Margins that cross zero where the force changes formula, shape (rows, n): the

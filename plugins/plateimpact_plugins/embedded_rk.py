@@ -54,10 +54,11 @@ def _combine(weights: np.ndarray, stages: np.ndarray) -> np.ndarray:
 class RungeKuttaDense(DenseOutput):
     """A pair's dense output, its polynomial built only for the scenes asked for."""
 
-    __slots__ = ("h", "matrix", "stages", "y0")
+    __slots__ = ("h", "matrix", "stages", "whole", "y0")
 
     def __init__(self, y0: np.ndarray, h: np.ndarray, stages: np.ndarray, matrix: np.ndarray):
         self.y0, self.h, self.stages, self.matrix = y0, h, stages, matrix
+        self.whole: PolynomialDenseOutput | None = None
 
     def polynomial(self, index: np.ndarray | slice) -> PolynomialDenseOutput:
         """Coefficients c_q = h Σ_j P[j, q] k_j, stage by stage in a fixed order (a scene's
@@ -71,7 +72,9 @@ class RungeKuttaDense(DenseOutput):
         return PolynomialDenseOutput(self.y0[:, index], coefficients * self.h[index])
 
     def __call__(self, sigma: float | np.ndarray) -> np.ndarray:
-        return self.polynomial(slice(None))(sigma)
+        if self.whole is None:
+            self.whole = self.polynomial(slice(None))
+        return self.whole(sigma)
 
     def take(self, index: np.ndarray) -> PolynomialDenseOutput:
         return self.polynomial(index)
