@@ -1,10 +1,16 @@
 from __future__ import annotations
 
+import importlib
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import plateimpact as pi
 from plateimpact import presets
+
+#: A third-party plug-in package, usable without installing it (its .dist-info is beside it).
+THIRD_PARTY = Path(__file__).resolve().parent / "third_party"
 
 
 @pytest.fixture(scope="session")
@@ -15,6 +21,17 @@ def sphere() -> pi.Sphere:
 @pytest.fixture(scope="session")
 def radius(sphere: pi.Sphere) -> float:
     return sphere.radius
+
+
+@pytest.fixture
+def with_third_party(monkeypatch):
+    """The package in tests/third_party installed, as far as entry points can tell (its
+    .dist-info is beside it), for this test only."""
+    monkeypatch.syspath_prepend(str(THIRD_PARTY))
+    importlib.invalidate_caches()
+    pi.default_registry.cache_clear()
+    yield
+    pi.default_registry.cache_clear()
 
 
 def sweep(

@@ -336,8 +336,11 @@ def test_calibrate_out_plate_file_runs_like_the_explicit_flags(tmp_path, capsys)
         ("{", [], "not valid JSON"),
         ('{"format": "other"}', [], "not a plateimpact plate file"),
         ('{"format": "plateimpact-plate-1", "material": "x"}', [], "missing key thickness_mm"),
-        ('{"format": "plateimpact-plate-1", "material": "x", "thickness_mm": 3, "pstar": 3}', [],
-         "unknown key 'pstar'"),
+        (
+            '{"format": "plateimpact-plate-1", "material": "x", "thickness_mm": 3, "pstar": 3}',
+            [],
+            "unknown key 'pstar'",
+        ),
     ],
 )
 def test_bad_plate_files_are_one_line_and_exit_2(content, extra, named, tmp_path, capsys):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import ast
-import importlib
 import json
 import os
 import subprocess
@@ -20,17 +19,6 @@ from plateimpact import presets
 
 ROOT = Path(__file__).resolve().parents[1]
 THIRD_PARTY = Path(__file__).resolve().parent / "third_party"
-
-
-@pytest.fixture
-def with_third_party(monkeypatch):
-    """The package in tests/third_party installed, as far as entry points can tell (its
-    .dist-info is beside it), for this test only."""
-    monkeypatch.syspath_prepend(str(THIRD_PARTY))
-    importlib.invalidate_caches()
-    pi.default_registry.cache_clear()
-    yield
-    pi.default_registry.cache_clear()
 
 
 def test_builtins_arrive_only_through_the_entry_point_group():

@@ -14,13 +14,12 @@ import attrs
 import h5py
 import numpy as np
 import pytest
+from conftest import THIRD_PARTY
 from scipy.integrate import solve_ivp
 
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.storage.plate_file import load_plate_file, plate_file_text
-
-from test_plugins import THIRD_PARTY, with_third_party  # noqa: F401 (fixture)
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("6061-T6/9.53")
@@ -145,7 +144,11 @@ def test_a_constant_declared_two_ways_is_refused(with_third_party):
     registry = pi.load_registry()
     other = attrs.evolve(pi.load_registry().plate_constants["a"], description="something else")
     impostor = type(
-        "Impostor", (pi.ResistanceLaw,), {"name": "impostor", "plate_constants": (other,), "stress": None}
+        "Impostor",
+        (pi.ResistanceLaw,),
+        {"name": "impostor", "plate_constants": (other,), "stress": None},
     )
-    with pytest.raises(pi.PluginError, match="declares plate constant 'a' unlike resistance poncelet"):
+    with pytest.raises(
+        pi.PluginError, match="declares plate constant 'a' unlike resistance poncelet"
+    ):
         registry.add(impostor)

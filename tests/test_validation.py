@@ -35,7 +35,11 @@ def run(plate: pi.Plate) -> pi.Result:
         # model reads the plate.
         (lambda: run(attrs.evolve(PLATE, a=-1.0)), "a", "> 0 N/m^2"),
         (lambda: run(attrs.evolve(PLATE, b=-1.0)), "b", ">= 0 kg/m^3"),
-        (lambda: run(attrs.evolve(PLATE, critical_penetration=0.0)), "critical_penetration", "> 0 mm"),
+        (
+            lambda: run(attrs.evolve(PLATE, critical_penetration=0.0)),
+            "critical_penetration",
+            "> 0 mm",
+        ),
         (
             lambda: run(attrs.evolve(PLATE, critical_penetration=-math.inf)),
             "critical_penetration",

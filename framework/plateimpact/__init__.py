@@ -2,154 +2,191 @@
 
 The public API, for study scripts and plug-in authors. SI units throughout; see
 :mod:`plateimpact.units` for mm, g and degrees.
+
+Every name is imported on first use (PEP 562), so ``import plateimpact`` is cheap and a
+script pays only for what it uses (scipy, h5py and matplotlib are loaded by the parts
+that need them).
 """
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
+import importlib
+from typing import TYPE_CHECKING, Any
 
-from . import geometry, presets, units
-from .storage.archive import Archive
-from .batch import SceneBatch
-from .bodies import Plate, Sphere
-from .calibration import (
-    Calibration,
-    CalibrationReport,
-    DriFit,
-    calibrate,
-    direct_fit,
-    energy_balance_start,
-    fit_dri,
-    newton_fit,
-)
-from .binding import BoundBatch
-from .dense import DenseOutput, PolynomialDenseOutput, hermite
-from .dynamics import Dynamics
-from .errors import (
-    ArchiveError,
-    CalibrationError,
-    ConvergenceError,
-    IntegrationError,
-    ParameterError,
-    PlateFileError,
-    PlateImpactError,
-    PluginError,
-    ShotDataError,
-    UnknownNameError,
-)
-from .failure import FailureModel
-from .geometry import contact_geometry, contact_lost_margin, force_inclination
-from .hookspecs import hookimpl
-from .integrator import MAX_STEPS, RTOL, Integrator, Step, StepControl, StepperState
-from .parameters import Parameter, Range
-from .plugin import Column
-from .model import (
-    AT_REST,
-    CONTACT_LOST,
-    EVENT_NAMES,
-    EVENT_OUTCOMES,
-    KINEMATIC_STATE,
-    LATERAL,
-    OBLIQUITY,
-    ONSET,
-    PENETRATION,
-    PERFORATED,
-    SPEED,
-    TURNED_BACK,
-    ImpactModel,
-)
-from .storage.plate_file import load_plate_file, save_plate_file
-from .registry import PluginRegistry, default_registry, load_registry
-from .resistance import BoundResistance, ResistanceLaw, contact_force
-from .results import BatchResult, Outcome, Result, Trajectory
-from .scene import Scene
-from .storage.shots import Shots, synthetic_shots
-from .simulation import Simulation, run
-from .study import Comparison, Study, StudyResults
-from .variant import Variant
+#: Public name -> the module that defines it.
+_EXPORTS: dict[str, str] = {
+    # the model's data
+    "Sphere": "bodies",
+    "Plate": "bodies",
+    "Scene": "scene",
+    "SceneBatch": "batch",
+    "Parameter": "parameters",
+    "Range": "parameters",
+    # plug-in interfaces
+    "ResistanceLaw": "resistance",
+    "BoundResistance": "resistance",
+    "contact_force": "resistance",
+    "FailureModel": "failure",
+    "Integrator": "integrator",
+    "Step": "integrator",
+    "StepControl": "integrator",
+    "StepperState": "integrator",
+    "MAX_STEPS": "integrator",
+    "RTOL": "integrator",
+    "Column": "plugin",
+    "Dynamics": "dynamics",
+    "DenseOutput": "dense",
+    "PolynomialDenseOutput": "dense",
+    "hermite": "dense",
+    "BoundBatch": "binding",
+    "hookimpl": "hookspecs",
+    "PluginRegistry": "registry",
+    "default_registry": "registry",
+    "load_registry": "registry",
+    # the model and its events
+    "ImpactModel": "model",
+    "KINEMATIC_STATE": "model",
+    "PENETRATION": "model",
+    "LATERAL": "model",
+    "OBLIQUITY": "model",
+    "SPEED": "model",
+    "ONSET": "model",
+    "CONTACT_LOST": "model",
+    "PERFORATED": "model",
+    "AT_REST": "model",
+    "TURNED_BACK": "model",
+    "EVENT_NAMES": "model",
+    "EVENT_OUTCOMES": "model",
+    "contact_geometry": "geometry",
+    "contact_lost_margin": "geometry",
+    "force_inclination": "geometry",
+    # running
+    "Simulation": "simulation",
+    "run": "simulation",
+    "Variant": "variant",
+    "Outcome": "results",
+    "Result": "results",
+    "BatchResult": "results",
+    "Trajectory": "results",
+    "CraterSection": "results",
+    "Ragged": "ragged",
+    # storage
+    "Archive": "storage.archive",
+    "load_plate_file": "storage.plate_file",
+    "save_plate_file": "storage.plate_file",
+    "Shots": "storage.shots",
+    "synthetic_shots": "storage.shots",
+    # analysis
+    "Study": "study",
+    "StudyResults": "study",
+    "Comparison": "study",
+    "Calibration": "calibration",
+    "CalibrationReport": "calibration",
+    "DriFit": "calibration",
+    "calibrate": "calibration",
+    "direct_fit": "calibration",
+    "energy_balance_start": "calibration",
+    "fit_dri": "calibration",
+    "newton_fit": "calibration",
+    # errors
+    "PlateImpactError": "errors",
+    "ParameterError": "errors",
+    "UnknownNameError": "errors",
+    "IntegrationError": "errors",
+    "ArchiveError": "errors",
+    "ShotDataError": "errors",
+    "PlateFileError": "errors",
+    "CalibrationError": "errors",
+    "ConvergenceError": "errors",
+    "PluginError": "errors",
+}
+#: Submodules users reach as attributes (``pi.units.mm``).
+_SUBMODULES = ("batch", "calibration", "geometry", "presets", "units")
 
-try:
-    __version__ = version("plateimpact")
-except PackageNotFoundError:  # running from a source tree
-    __version__ = "0+unknown"
+__all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
-__all__ = [
-    "AT_REST",
-    "CONTACT_LOST",
-    "EVENT_NAMES",
-    "EVENT_OUTCOMES",
-    "KINEMATIC_STATE",
-    "LATERAL",
-    "MAX_STEPS",
-    "OBLIQUITY",
-    "ONSET",
-    "PENETRATION",
-    "PERFORATED",
-    "RTOL",
-    "SPEED",
-    "TURNED_BACK",
-    "Archive",
-    "ArchiveError",
-    "CalibrationError",
-    "CalibrationReport",
-    "ConvergenceError",
-    "BatchResult",
-    "BoundBatch",
-    "BoundResistance",
-    "Calibration",
-    "Column",
-    "Comparison",
-    "DenseOutput",
-    "DriFit",
-    "Dynamics",
-    "FailureModel",
-    "ImpactModel",
-    "IntegrationError",
-    "Integrator",
-    "Outcome",
-    "Parameter",
-    "ParameterError",
-    "Plate",
-    "PlateFileError",
-    "PlateImpactError",
-    "PluginError",
-    "PluginRegistry",
-    "PolynomialDenseOutput",
-    "Range",
-    "ResistanceLaw",
-    "Result",
-    "Scene",
-    "SceneBatch",
-    "ShotDataError",
-    "Shots",
-    "Simulation",
-    "Step",
-    "StepControl",
-    "StepperState",
-    "Study",
-    "StudyResults",
-    "Sphere",
-    "Trajectory",
-    "UnknownNameError",
-    "Variant",
-    "calibrate",
-    "contact_force",
-    "contact_geometry",
-    "contact_lost_margin",
-    "default_registry",
-    "direct_fit",
-    "energy_balance_start",
-    "fit_dri",
-    "force_inclination",
-    "geometry",
-    "hermite",
-    "hookimpl",
-    "load_plate_file",
-    "load_registry",
-    "newton_fit",
-    "presets",
-    "run",
-    "save_plate_file",
-    "synthetic_shots",
-    "units",
-]
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    elif name in _SUBMODULES:
+        value = importlib.import_module(f".{name}", __name__)
+    elif name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
+
+        try:
+            value = version("plateimpact")
+        except PackageNotFoundError:  # running from a source tree
+            value = "0+unknown"
+    else:
+        raise AttributeError(f"module 'plateimpact' has no attribute {name!r}")
+    globals()[name] = value  # the next look-up is a plain attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return __all__
+
+
+if TYPE_CHECKING:  # what type checkers and IDEs see
+    from . import batch, calibration, geometry, presets, units
+    from .binding import BoundBatch
+    from .bodies import Plate, Sphere
+    from .calibration import (
+        Calibration,
+        CalibrationReport,
+        DriFit,
+        calibrate,
+        direct_fit,
+        energy_balance_start,
+        fit_dri,
+        newton_fit,
+    )
+    from .dense import DenseOutput, PolynomialDenseOutput, hermite
+    from .dynamics import Dynamics
+    from .errors import (
+        ArchiveError,
+        CalibrationError,
+        ConvergenceError,
+        IntegrationError,
+        ParameterError,
+        PlateFileError,
+        PlateImpactError,
+        PluginError,
+        ShotDataError,
+        UnknownNameError,
+    )
+    from .failure import FailureModel
+    from .geometry import contact_geometry, contact_lost_margin, force_inclination
+    from .hookspecs import hookimpl
+    from .integrator import MAX_STEPS, RTOL, Integrator, Step, StepControl, StepperState
+    from .model import (
+        AT_REST,
+        CONTACT_LOST,
+        EVENT_NAMES,
+        EVENT_OUTCOMES,
+        KINEMATIC_STATE,
+        LATERAL,
+        OBLIQUITY,
+        ONSET,
+        PENETRATION,
+        PERFORATED,
+        SPEED,
+        TURNED_BACK,
+        ImpactModel,
+    )
+    from .parameters import Parameter, Range
+    from .plugin import Column
+    from .ragged import Ragged
+    from .registry import PluginRegistry, default_registry, load_registry
+    from .resistance import BoundResistance, ResistanceLaw, contact_force
+    from .results import BatchResult, CraterSection, Outcome, Result, Trajectory
+    from .scene import Scene
+    from .simulation import Simulation, run
+    from .storage.archive import Archive
+    from .storage.plate_file import load_plate_file, save_plate_file
+    from .storage.shots import Shots, synthetic_shots
+    from .study import Comparison, Study, StudyResults
+    from .variant import Variant
+
+    __version__: str

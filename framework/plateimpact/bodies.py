@@ -94,7 +94,7 @@ class Plate:
     material: str = attrs.field(validator=attrs.validators.instance_of(str))
     thickness: float = THICKNESS.field()
     #: (name, SI value) pairs, sorted by name.
-    constants: tuple[tuple[str, float], ...] = attrs.field()
+    constants: tuple[tuple[str, float], ...] = attrs.field(default=())
 
     def __init__(
         self,
@@ -106,7 +106,7 @@ class Plate:
         merged = dict(constants)
         merged.update(named)
         pairs = tuple(sorted((name, _constant(name, value)) for name, value in merged.items()))
-        self.__attrs_init__(material, thickness, pairs)  # type: ignore[attr-defined]
+        self.__attrs_init__(material, thickness, pairs)
 
     def __getattr__(self, name: str) -> float:
         if name.startswith("_") or name == "constants":
@@ -120,3 +120,7 @@ class Plate:
     def constant_values(self) -> dict[str, float]:
         """The constants as a dict [SI]."""
         return dict(self.constants)
+
+    def with_constants(self, **changes: float) -> Plate:
+        """The same plate with some constants changed or added [SI]."""
+        return Plate(self.material, self.thickness, {**self.constant_values(), **changes})

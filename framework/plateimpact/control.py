@@ -66,7 +66,9 @@ class StepSizes:
             norm = np.max(np.abs(step.error) / scale, axis=0)
         ok = np.isfinite(norm) & finite & (norm <= 1.0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            factor = np.clip(SAFETY * norm ** (-1.0 / self.control.error_order), MIN_FACTOR, MAX_FACTOR)
+            factor = np.clip(
+                SAFETY * norm ** (-1.0 / self.control.error_order), MIN_FACTOR, MAX_FACTOR
+            )
         # A step that follows a rejection may not grow: where the error per step rises
         # along the path (a sphere turning ever faster before ricochet) this ends the
         # reject-accept cycle that otherwise costs every other step. Measured: 745 -> 640

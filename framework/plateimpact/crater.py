@@ -106,9 +106,7 @@ def _surface_crossing(grid: np.ndarray, floor: np.ndarray, outside: int, inside:
     return float(grid[inside] + fraction * (grid[outside] - grid[inside]))
 
 
-def crater_sections(
-    result: BatchResult, radius: np.ndarray, thickness: np.ndarray
-) -> Ragged:
+def crater_sections(result: BatchResult, radius: np.ndarray, thickness: np.ndarray) -> Ragged:
     """The sections of every scene of ``result`` (recorded with its trajectories) for
     sphere radii ``radius`` [m] and plate thicknesses ``thickness`` [m], per scene: a
     ragged array with ``lateral`` and ``depth`` per point and ``impact_point`` per scene

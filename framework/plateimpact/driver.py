@@ -74,7 +74,7 @@ def _integrate(
     )
     state = integrator.start(dynamics, t, y)
     at = np.linspace(0.0, 1.0, integrator.event_samples)
-    recorder.sample(scene, t, *y[:KINEMATIC_STATE], y[KINEMATIC_STATE:], failed)
+    recorder.sample(scene, t, y, failed)
     # The event margins at each scene's current state, where known: a step's end is the
     # next step's start unless an event changed the scene.
     margins_now, known = np.empty((5, n)), np.zeros(n, bool)
@@ -119,26 +119,16 @@ def _integrate(
             peak[crest_rows] = np.maximum(peak[crest_rows], crest[PENETRATION])
             if recorder.record_trajectory:  # the deepest point belongs to the path
                 at_crest = idx[crest_rows]
-                recorder.sample(
-                    scene[at_crest],
-                    t[at_crest] + crest_sigma[crest_rows] * h0[crest_rows],
-                    *crest[:KINEMATIC_STATE],
-                    crest[KINEMATIC_STATE:],
-                    failed[at_crest],
-                )
+                times = t[at_crest] + crest_sigma[crest_rows] * h0[crest_rows]
+                recorder.sample(scene[at_crest], times, crest, failed[at_crest])
         max_pen[sel] = np.maximum(max_pen[sel], peak)
         if recorder.record_trajectory:
             for j in range(1, at.size):
                 keep = at[j] < end_sigma
                 if keep.any():
-                    s_y = samples[:, j, keep]
-                    recorder.sample(
-                        scene[idx[keep]],
-                        t[idx[keep]] + at[j] * h0[keep],
-                        *s_y[:KINEMATIC_STATE],
-                        s_y[KINEMATIC_STATE:],
-                        failed[idx[keep]],
-                    )
+                    rows = idx[keep]
+                    times = t[rows] + at[j] * h0[keep]
+                    recorder.sample(scene[rows], times, samples[:, j, keep], failed[rows])
 
         # Advance; cut steps end at their event.
         y[:, sel], t[sel] = y_end, t_end
@@ -154,16 +144,11 @@ def _integrate(
             mask[onset] = True
             failed = failed | mask
             failure_state = y[KINEMATIC_STATE:]
-            model.start_failure(
-                mask, y[PENETRATION], y[OBLIQUITY], y[SPEED], failure_state, batch
-            )
+            model.start_failure(mask, y[PENETRATION], y[OBLIQUITY], y[SPEED], failure_state, batch)
             y[KINEMATIC_STATE:] = failure_state
             recorder.failed(scene[onset], t[onset], y[PENETRATION, onset], y[LATERAL, onset])
         if recorder.record_trajectory:  # the step's end; where the plate failed, its state
-            y_end = y[:, sel]
-            recorder.sample(
-                scene[sel], t_end, *y_end[:KINEMATIC_STATE], y_end[KINEMATIC_STATE:], failed[sel]
-            )
+            recorder.sample(scene[sel], t_end, y[:, sel], failed[sel])
         turned = events[kinds == TURNED_BACK]
         if turned.size:
             held[turned] = True

@@ -64,7 +64,7 @@ def first_event(
     crossing = (margins[:, :-1] < 0.0) & (margins[:, 1:] >= 0.0)
     values = np.concatenate([margins, turning[np.newaxis]])  # (events + 1, s, m)
     bracket = np.concatenate([crossing, cresting[np.newaxis]])
-    has = bracket.any(axis=1)
+    has = np.asarray(bracket.any(axis=1))
     first = np.argmax(bracket, axis=1)  # (events + 1, m)
     earliest = np.where(has[:count], first[:count], at.size).min(axis=0)
     candidate = has.copy()

@@ -9,7 +9,7 @@ import attrs
 import numpy as np
 
 from .batch import CORE_COLUMNS, SceneBatch
-from .binding import SLOTS, BoundBatch
+from .binding import BoundBatch
 from .errors import ParameterError, PluginError
 from .failure import FailureModel
 from .geometry import branch_margins, contact_lost_margin
@@ -49,6 +49,16 @@ EVENT_OUTCOMES = {
 }
 
 
+def _plugin_of(kind: type) -> Any:
+    """An attrs validator: an instance of the (abstract) plug-in interface ``kind``."""
+
+    def check(instance: object, attribute: attrs.Attribute, value: object) -> None:
+        if not isinstance(value, kind):
+            raise PluginError(f"{attribute.name} must be a {kind.__name__}, got {value!r}")
+
+    return check
+
+
 @attrs.frozen
 class ImpactModel:
     """A resistance law and a failure model, resolved once, used on whole batches.
@@ -63,8 +73,8 @@ class ImpactModel:
         then. In (0, 1); default 0.01.
     """
 
-    resistance: ResistanceLaw = attrs.field(validator=attrs.validators.instance_of(ResistanceLaw))
-    failure: FailureModel = attrs.field(validator=attrs.validators.instance_of(FailureModel))
+    resistance: ResistanceLaw = attrs.field(validator=_plugin_of(ResistanceLaw))
+    failure: FailureModel = attrs.field(validator=_plugin_of(FailureModel))
     rest_speed_fraction: float = REST_SPEED_FRACTION.field()
 
     #: Obliquity is held here once reached (model-notes §4): straight back out [rad].
@@ -334,7 +344,9 @@ def check_declarations(plugins: dict[str, Any]) -> None:
         label = f"{slot} {plugin.name!r}"
         for declared in plugin.plate_constants:
             if declared.name in CORE_COLUMNS:
-                raise PluginError(f"{label} declares plate constant {declared.name!r}, a core column")
+                raise PluginError(
+                    f"{label} declares plate constant {declared.name!r}, a core column"
+                )
             if declared.name in seen and seen[declared.name][0] != declared:
                 raise PluginError(
                     f"{seen[declared.name][1]} and {label} both claim plate constant "
@@ -370,7 +382,10 @@ def _checked_columns(
     """The columns a plug-in prepared, exactly those it declared, one float per scene."""
     declared = [c.name for c in plugin.columns]
     if set(prepared) != set(declared):
-        extra, missing = sorted(set(prepared) - set(declared)), sorted(set(declared) - set(prepared))
+        extra, missing = (
+            sorted(set(prepared) - set(declared)),
+            sorted(set(declared) - set(prepared)),
+        )
         what = f"undeclared column {extra[0]!r}" if extra else f"no column {missing[0]!r}"
         raise PluginError(f"{slot} {plugin.name!r}: prepare() returned {what}")
     return {

@@ -33,6 +33,7 @@ def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
     fig = Figure(figsize=kwargs.pop("figsize", None), layout=kwargs.pop("layout", None))
     return fig, fig.subplots(nrows, ncols, **kwargs)
 
+
 OUTCOME_SHADES = {
     Outcome.RICOCHET: "#dbe9f6",
     Outcome.EMBEDMENT: "#f3e3c3",
@@ -58,7 +59,7 @@ def plot_exit_curves(
     *,
     label: str | None = None,
     shade: bool = True,
-    **style: object,
+    **style: Any,
 ) -> Sequence[Axes]:
     """Exit speed and exit obliquity against impact speed (the report's Figures 11–44).
 
@@ -88,7 +89,7 @@ def plot_crater(
     trajectory: Trajectory | None = None,
     radius: float | None = None,
     label: str | None = None,
-    **style: object,
+    **style: Any,
 ) -> Axes:
     """The crater floor, depth downward, in mm from the entry point; with ``trajectory``
     and ``radius``, the centre's path and the sphere at first contact, deepest, last."""
@@ -263,9 +264,11 @@ def plot_study_paths(
                 name = f"{study.scenes.impact_speed[i]:g} m/s, {Outcome(result.outcome[i]).label}"
                 if kind == "crater":
                     section = result.crater_of(i)
+                    assert section is not None  # checked above
                     ax.plot(section.lateral * 1e3, section.depth * 1e3, label=name, **style)
                 else:
                     path = result.trajectory_of(i)
+                    assert path is not None  # checked above
                     centre = (path.penetration - study.scenes.radius[i]) * 1e3
                     ax.plot(path.lateral * 1e3, centre, label=name, **style)
         ax.axhline(0.0, color="0.3", lw=0.8)

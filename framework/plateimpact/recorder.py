@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .model import KINEMATIC_STATE
 from .ragged import Ragged
 from .results import RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 
@@ -21,7 +22,9 @@ class ResultRecorder:
         self.size = size
         self.record_trajectory = record_trajectory
         self.failure_state_names = failure_state_names
-        self.columns: dict[str, np.ndarray] = {name: np.full(size, np.nan) for name in RESULT_FIELDS}
+        self.columns: dict[str, np.ndarray] = {
+            name: np.full(size, np.nan) for name in RESULT_FIELDS
+        }
         self.columns["outcome"] = np.zeros(size, dtype=np.int8)
         self.columns["plate_failed"] = np.zeros(size, dtype=bool)
         self._samples: list[tuple[np.ndarray, ...]] = []
@@ -33,27 +36,15 @@ class ResultRecorder:
         }
 
     def sample(
-        self,
-        scene: np.ndarray,
-        time: np.ndarray,
-        penetration: np.ndarray,
-        lateral: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        failure_state: np.ndarray | None = None,
-        failed: np.ndarray | None = None,
+        self, scene: np.ndarray, time: np.ndarray, y: np.ndarray, failed: np.ndarray
     ) -> None:
-        """Record the state of ``scene`` s if trajectories were asked for.
-
-        ``failure_state`` has shape (len(failure_state_names), n); where ``failed`` is
-        False it means nothing and is recorded as NaN.
-        """
+        """Record the states ``y`` (d, n: P, Y, θ, V, then the failure state) of scenes
+        ``scene`` at ``time`` [s], if trajectories were asked for. The failure state means
+        nothing where ``failed`` is False and is recorded as NaN there."""
         if not self.record_trajectory:
             return
-        columns = [time, penetration, lateral, obliquity, speed]
-        if self.failure_state_names:
-            mask = np.ones(np.shape(time), bool) if failed is None else failed
-            columns.extend(np.where(mask, failure_state, np.nan))
+        state = np.where(failed, y[KINEMATIC_STATE:], np.nan)
+        columns = [time, *y[:KINEMATIC_STATE], *state]
         self._samples.append((scene.copy(), *(np.array(c, dtype=float) for c in columns)))
 
     def failed(

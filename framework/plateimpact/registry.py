@@ -48,18 +48,19 @@ class PluginRegistry:
         if not isinstance(name, str) or not name:
             raise PluginError(f"{cls.__qualname__} ({cls.__module__}) has no 'name'")
         kind = kinds[0]
+        plugin: type[Plugin] = cls
         label = f"{kind} {name!r} ({cls.__module__})"
         if name in self._classes[kind] and self._classes[kind][name] is not cls:
             raise PluginError(
                 f"{kind} {name!r} is registered twice: by {self._origin[kind, name]} "
                 f"and by {cls.__module__}"
             )
-        self._check_declarations(cls, label)
-        for declared in cls.plate_constants:
+        self._check_declarations(plugin, label)
+        for declared in plugin.plate_constants:
             entry = self._constants.setdefault(declared.name, (declared, []))
             entry[1].append(f"{kind} {name}")
-        self._classes[kind][name] = cls
-        self._origin[kind, name] = cls.__module__
+        self._classes[kind][name] = plugin
+        self._origin[kind, name] = plugin.__module__
 
     def _check_declarations(self, cls: type[Plugin], label: str) -> None:
         constants = list(cls.plate_constants)

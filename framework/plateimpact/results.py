@@ -42,11 +42,19 @@ RESULT_FIELDS: dict[str, Parameter] = {
             scale=_DEG,
         ),
         Parameter("contact_time", "time from first contact to the outcome", "s"),
-        Parameter("max_penetration", "largest penetration P reached", "m", display_unit="mm", scale=_MM),
-        Parameter("plate_failed", "whether the plate failed (P reached the onset penetration)", kind=bool),
+        Parameter(
+            "max_penetration", "largest penetration P reached", "m", display_unit="mm", scale=_MM
+        ),
+        Parameter(
+            "plate_failed", "whether the plate failed (P reached the onset penetration)", kind=bool
+        ),
         Parameter("failure_time", "time of plate failure (NaN: none)", "s"),
         Parameter(
-            "failure_penetration", "penetration at plate failure (NaN: none)", "m", display_unit="mm", scale=_MM
+            "failure_penetration",
+            "penetration at plate failure (NaN: none)",
+            "m",
+            display_unit="mm",
+            scale=_MM,
         ),
         Parameter(
             "failure_lateral",
@@ -69,7 +77,13 @@ TRAJECTORY_FIELDS: dict[str, Parameter] = {
             display_unit="mm",
             scale=_MM,
         ),
-        Parameter("lateral", "lateral displacement Y of the sphere's centre", "m", display_unit="mm", scale=_MM),
+        Parameter(
+            "lateral",
+            "lateral displacement Y of the sphere's centre",
+            "m",
+            display_unit="mm",
+            scale=_MM,
+        ),
         Parameter(
             "obliquity",
             "direction theta of the velocity from the plate normal",
@@ -85,9 +99,19 @@ CRATER_FIELDS: dict[str, Parameter] = {
     p.name: p
     for p in (
         Parameter(
-            "lateral", "distance along the plate from the crater's entry point", "m", display_unit="mm", scale=_MM
+            "lateral",
+            "distance along the plate from the crater's entry point",
+            "m",
+            display_unit="mm",
+            scale=_MM,
         ),
-        Parameter("depth", "depth of the crater floor below the front surface", "m", display_unit="mm", scale=_MM),
+        Parameter(
+            "depth",
+            "depth of the crater floor below the front surface",
+            "m",
+            display_unit="mm",
+            scale=_MM,
+        ),
         Parameter(
             "impact_point",
             "lateral position of first contact in the section's coordinates",

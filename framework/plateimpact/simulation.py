@@ -12,7 +12,7 @@ import numpy as np
 from .batch import SceneBatch
 from .crater import crater_sections
 from .driver import integrate
-from .errors import ParameterError
+from .errors import ParameterError, PluginError
 from .integrator import Integrator
 from .model import REST_SPEED_FRACTION, ImpactModel
 from .registry import PluginRegistry, default_registry
@@ -29,6 +29,11 @@ DEFAULT_INTEGRATOR = "dopri5"
 DEFAULT_CHUNK_SIZE = 2500
 
 
+def _integrator(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    if not isinstance(value, Integrator):
+        raise PluginError(f"integrator must be an Integrator, got {value!r}")
+
+
 @attrs.frozen
 class Simulation:
     """Runs scenes through one resolved model and integrator.
@@ -38,7 +43,7 @@ class Simulation:
     """
 
     model: ImpactModel
-    integrator: Integrator = attrs.field(validator=attrs.validators.instance_of(Integrator))
+    integrator: Integrator = attrs.field(validator=_integrator)
 
     @classmethod
     def from_names(

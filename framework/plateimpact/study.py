@@ -24,7 +24,6 @@ from .storage.provenance import RunMetadata
 from .variant import Variant, check_name
 
 
-
 def _variants(value: Iterable[Variant] | Variant) -> tuple[Variant, ...]:
     variants = (value,) if isinstance(value, Variant) else tuple(value)
     names = [v.name for v in variants]
@@ -167,7 +166,7 @@ class Study:
             writer.check_writable()
         if resume and writer is None:
             raise ParameterError("resume", "resume=True needs the archive to resume from")
-        finished = writer.finished_runs(self) if resume else {}
+        finished = writer.finished_runs(self) if writer is not None and resume else {}
         simulations = {
             v.name: v.simulation(registry) for v in self.variants if v.name not in finished
         }
@@ -178,7 +177,7 @@ class Study:
         runs: dict[str, BatchResult] = {}
         with progress_bar(self.scenes.size * len(self.variants), self.name, progress) as bar:
             for variant in self.variants:
-                if variant.name in finished:
+                if writer is not None and variant.name in finished:
                     kept = writer.results(finished[variant.name])
                     lacks = (craters and kept.craters is None) or (
                         record_trajectory and kept.trajectory is None

@@ -94,7 +94,9 @@ class ScipyIVP(Integrator):
 
         solver_class = getattr(integrate, self.method)
         bound = float(t[i] + LONGEST_PHASE * one.time_scale[0])
-        return solver_class(rates, t[i], y[:, i].copy(), bound, rtol=self.rtol, atol=self.rtol * scale)
+        return solver_class(
+            rates, t[i], y[:, i].copy(), bound, rtol=self.rtol, atol=self.rtol * scale
+        )
 
     def advance(
         self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray, h: np.ndarray, state: StepperState

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from abc import abstractmethod
+from typing import ClassVar
 
 import numpy as np
 
-from plateimpact import BoundResistance, Column, FailureModel, SceneBatch, geometry
+from plateimpact import BoundResistance, Column, FailureModel, Parameter, SceneBatch, geometry
 
 from .plate_constants import FAILURE_ANGLE
 
@@ -29,8 +30,10 @@ class PlaneSeparation(FailureModel):
     force (:meth:`force_change` of the hinge adds the finger).
     """
 
-    plate_constants = (FAILURE_ANGLE,)
-    columns = (Column("failure_plane_depth", "m", "depth h of the failure plane (eq 8)"),)
+    plate_constants: ClassVar[tuple[Parameter, ...]] = (FAILURE_ANGLE,)
+    columns: ClassVar[tuple[Column, ...]] = (
+        Column("failure_plane_depth", "m", "depth h of the failure plane (eq 8)"),
+    )
 
     @abstractmethod
     def onset_penetration(self, batch: SceneBatch) -> np.ndarray: ...

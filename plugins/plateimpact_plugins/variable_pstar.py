@@ -51,7 +51,7 @@ class PstarTable:
     transition_end: np.ndarray
 
     @classmethod
-    def from_rows(cls, rows: Sequence[Sequence[float]]) -> PstarTable:
+    def from_rows(cls, rows: Sequence[Sequence[float | str]]) -> PstarTable:
         """Rows of (obliquity [deg], ricochet P* [mm], perforation P* [mm], transition
         start [m/s], transition end [m/s]), sorted by obliquity."""
         if len(rows) == 0:

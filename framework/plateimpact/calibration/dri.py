@@ -52,7 +52,6 @@ class DriFit:
         return self.R * np.sqrt(np.clip(vs**2 - self.V0**2, 0.0, None))
 
 
-
 def fit_dri(impact_speed: np.ndarray, residual_speed: np.ndarray) -> DriFit:
     """DRI fit (eqs 40–41) of the perforating shots among ``impact_speed``,
     ``residual_speed`` [m/s]; shots with residual speed 0 are left out.
@@ -93,4 +92,3 @@ def fit_dri(impact_speed: np.ndarray, residual_speed: np.ndarray) -> DriFit:
     cov = gradient @ cov_MB @ gradient.T
     residuals = vr - R * np.sqrt(np.clip(vs**2 - V0**2, 0.0, None))
     return DriFit(R, V0, math.sqrt(cov[0, 0]), math.sqrt(cov[1, 1]), cov, vs.copy(), residuals)
-

@@ -14,7 +14,7 @@ from ..errors import CalibrationError, ConvergenceError
 from ..presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
-from .dri import DriFit, fit_dri
+from .dri import MIN_PERFORATIONS, DriFit, fit_dri
 from .start import energy_balance_start, fit_model_dri, model_residual_speeds, normal_shots
 
 #: Relative step of a and b for the finite differences of eqs 44–47 (and the direct fit).
@@ -118,13 +118,17 @@ def newton_fit(
     a, b = start or energy_balance_start(target.R, target.V0, sphere, plate)
     scale = np.array([target.R, target.V0])  # relative differences, eqs 48–49 scaled
 
-    def evaluate(a: float, b: float) -> tuple[np.ndarray, list[DriFit | None]]:
+    def evaluate(a: float, b: float) -> tuple[np.ndarray, list[DriFit] | None]:
+        """Residual speeds at (a, b) and its two nudges, and their DRI fits (None if the
+        model perforates too few of the speeds for one of them)."""
         constants = [(a, b), (a * (1 + step), b), (a, b * (1 + step))]
         residual = model_residual_speeds(simulation, sphere, plate, speeds, constants)
-        return residual, [fit_model_dri(speeds, r) for r in residual]
+        found = [fit_model_dri(speeds, r) for r in residual]
+        usable = [f for f in found if f is not None]
+        return residual, usable if len(usable) == len(found) else None
 
     residual, fits = evaluate(a, b)
-    if any(f is None for f in fits):
+    if fits is None:
         raise CalibrationError(
             f"at the start a = {a:.4g} N/m^2, b = {b:.4g} kg/m^3 the model perforates fewer "
             f"than {MIN_PERFORATIONS} of the shots' impact speeds"
@@ -149,7 +153,7 @@ def newton_fit(
             trial = a * (1 + correction[0]), b * (1 + correction[1])
             if min(trial) > 0.0:
                 trial_residual, trial_fits = evaluate(*trial)
-                if all(f is not None for f in trial_fits):
+                if trial_fits is not None:
                     break
             correction = correction / 2  # guard the domain: damp the step
         else:
@@ -162,6 +166,7 @@ def newton_fit(
                 )
             )
         (a, b), residual, fits = trial, trial_residual, trial_fits
+        assert fits is not None  # the halving loop breaks only on usable fits
         iterations += 1
     if not converged and raise_on_failure:
         raise ConvergenceError(
@@ -287,7 +292,7 @@ def _calibration(
     )
     return Calibration(
         method=method,
-        plate=attrs.evolve(plate, a=a, b=b),
+        plate=plate.with_constants(a=a, b=b),
         a_stderr=a_stderr,
         b_stderr=b_stderr,
         correlation=float(cov[0, 1] / (a_stderr * b_stderr)) if a_stderr * b_stderr else 0.0,
@@ -309,10 +314,9 @@ def calibrate(
     """The DRI fit of ``shots`` and a, b by both methods (``plate``: T, P*, α*)."""
     simulation = simulation or Simulation.from_names()
     normal = normal_shots(shots)
-    options = {"sphere": sphere, "simulation": simulation}
     return CalibrationReport(
         shots=shots,
         dri=fit_dri(normal.impact_speed, normal.residual_speed),
-        newton=newton_fit(shots, plate, **options),
-        direct=direct_fit(shots, plate, **options),
+        newton=newton_fit(shots, plate, sphere=sphere, simulation=simulation),
+        direct=direct_fit(shots, plate, sphere=sphere, simulation=simulation),
     )

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import attrs
 import numpy as np
 from scipy.integrate import quad
 
@@ -81,7 +80,7 @@ def model_residual_speeds(
     Embedments give 0."""
     speeds = np.asarray(impact_speeds, dtype=float)
     batch = SceneBatch.concat(
-        SceneBatch.grid(sphere, attrs.evolve(plate, a=a, b=b), speeds, np.zeros(1))
+        SceneBatch.grid(sphere, plate.with_constants(a=a, b=b), speeds, np.zeros(1))
         for a, b in constants
     )
     result = simulation.run_batch(batch)
@@ -108,4 +107,3 @@ def fit_model_dri(speeds: np.ndarray, residual: np.ndarray) -> DriFit | None:
         return fit_dri(speeds, residual)
     except CalibrationError:
         return None
-

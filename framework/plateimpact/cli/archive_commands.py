@@ -38,7 +38,9 @@ def add_parsers(sub: Any) -> None:
     p.add_argument("--png", metavar="FILE", help="overlay plot of the two runs")
     p.set_defaults(command_function=compare_command)
 
-    p = sub.add_parser("plot", help="exit curves, trajectories or crater sections of runs in an archive")
+    p = sub.add_parser(
+        "plot", help="exit curves, trajectories or crater sections of runs in an archive"
+    )
     p.add_argument("archive", help="HDF5 archive")
     p.add_argument("--run", required=True, action="append", help="run name (repeat to overlay)")
     p.add_argument("--out", required=True, metavar="FILE.png", help="where to draw")
@@ -64,7 +66,9 @@ def reproduce_command(args: argparse.Namespace) -> None:
     try:
         from plateimpact_studies.reproduce import reproduce  # noqa: PLC0415
     except ImportError:
-        raise UsageError("the report studies (package plateimpact_studies) are not installed") from None
+        raise UsageError(
+            "the report studies (package plateimpact_studies) are not installed"
+        ) from None
     out = Path(args.out)
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")

@@ -77,7 +77,11 @@ def csv_text(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:
     for row in rows:
         writer.writerow(
             [
-                str(x).lower() if isinstance(x, bool) else repr(float(x)) if isinstance(x, float) else x
+                str(x).lower()
+                if isinstance(x, bool)
+                else repr(float(x))
+                if isinstance(x, float)
+                else x
                 for x in row
             ]
         )

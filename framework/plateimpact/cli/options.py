@@ -49,7 +49,9 @@ def _aliases(registry: PluginRegistry) -> dict[str, tuple[str, str, list[tuple[s
 
 def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None:
     """--resistance, --failure, --integrator, --set and the declared setting aliases."""
-    group = parser.add_argument_group("model (plug-ins by name; see 'plateimpact plugins --details')")
+    group = parser.add_argument_group(
+        "model (plug-ins by name; see 'plateimpact plugins --details')"
+    )
     defaults = {
         "resistance": DEFAULT_RESISTANCE,
         "failure": DEFAULT_FAILURE,
@@ -57,7 +59,9 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
     }
     for kind, default in defaults.items():
         choices = ", ".join(registry.names(kind))
-        group.add_argument(f"--{kind}", default=default, help=f"{kind}: {choices} (default {default})")
+        group.add_argument(
+            f"--{kind}", default=default, help=f"{kind}: {choices} (default {default})"
+        )
     group.add_argument(
         "--set",
         action="append",
@@ -70,7 +74,9 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
         owners = "; ".join(f"{name}: default {d.format(d.default)}" for name, d in declarers)
         declared = declarers[0][1]
         help_text = f"--set {kind}.{setting}=: {declared.description} ({owners})"
-        group.add_argument(flag, dest=_dest(flag), metavar=declared.user_unit.upper(), help=help_text)
+        group.add_argument(
+            flag, dest=_dest(flag), metavar=declared.user_unit.upper(), help=help_text
+        )
 
 
 def add_body_options(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None:
@@ -84,6 +90,7 @@ def add_body_options(parser: argparse.ArgumentParser, registry: PluginRegistry) 
         "not with --preset or the plate options",
     )
     for declared in (THICKNESS, *_constant_flags(registry).values()):
+        assert declared.flag is not None
         group.add_argument(
             declared.flag,
             dest=_dest(declared.flag or ""),

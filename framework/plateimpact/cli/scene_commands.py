@@ -47,7 +47,9 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     p.set_defaults(command_function=crater_command)
 
     p = sub.add_parser("sweep", help="run a grid of speeds and obliquities")
-    p.add_argument("--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a comma list")
+    p.add_argument(
+        "--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a comma list"
+    )
     p.add_argument("--obliquities", required=True, help="impact obliquities [deg], a comma list")
     p.add_argument("--csv", metavar="FILE", help="write CSV here (default: standard output)")
     add_body_options(p, registry)
@@ -76,7 +78,11 @@ def run_command(args: argparse.Namespace) -> None:
         rows = zip(*(getattr(path, f.name) / f.scale for f in fields), strict=True)
         write_atomically(args.trajectory, csv_text([f.key for f in fields], rows), "--trajectory")
     speed, obliquity = float(args.speed), float(args.obliquity)
-    out: dict[str, Any] = {"preset": label, IMPACT_SPEED.key: speed, IMPACT_OBLIQUITY.key: obliquity}
+    out: dict[str, Any] = {
+        "preset": label,
+        IMPACT_SPEED.key: speed,
+        IMPACT_OBLIQUITY.key: obliquity,
+    }
     out.update(result.as_user_dict())
     out["model"] = simulation.describe()
     if args.json:
@@ -102,7 +108,9 @@ def crater_command(args: argparse.Namespace) -> None:
     scene, simulation, label = _scene(args)
     result = simulation.run(scene, record_trajectory=True)
     assert result.trajectory is not None
-    section = crater_section(result.trajectory, scene.sphere.radius, thickness=scene.plate.thickness)
+    section = crater_section(
+        result.trajectory, scene.sphere.radius, thickness=scene.plate.thickness
+    )
     print(
         f"{label}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
         f"{result.outcome.label}; crater {section.length * 1e3:.4g} mm long, "
@@ -117,9 +125,8 @@ def crater_command(args: argparse.Namespace) -> None:
 
         fig, ax = plotting.figure(figsize=(8, 4))
         plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
-        ax.set_title(
-            f"{label}, {float(args.speed):g} m/s at {float(args.obliquity):g}°: {result.outcome.label}"
-        )
+        speed, obliquity = float(args.speed), float(args.obliquity)
+        ax.set_title(f"{label}, {speed:g} m/s at {obliquity:g}°: {result.outcome.label}")
         save_figure_atomically(fig, args.png)
 
 

@@ -211,11 +211,15 @@ class Archive:
         for name, declared in RESULT_FIELDS.items():
             write_declared(results, declared, result.columns[name])
         if result.craters is not None:
-            write_ragged(group.create_group("crater"), result.craters, "counts", "lateral", CRATER_FIELDS)
+            write_ragged(
+                group.create_group("crater"), result.craters, "counts", "lateral", CRATER_FIELDS
+            )
         if result.trajectory is not None:
             state_units = json.loads(str(attributes.get("failure_state_units", "{}")))
-            declared = {k: _trajectory_field(k, state_units) for k in result.trajectory.values}
-            write_ragged(group.create_group("trajectory"), result.trajectory, "count", "time", declared)
+            fields = {k: _trajectory_field(k, state_units) for k in result.trajectory.values}
+            write_ragged(
+                group.create_group("trajectory"), result.trajectory, "count", "time", fields
+            )
 
     # -- reading ---------------------------------------------------------------------
 
@@ -229,7 +233,9 @@ class Archive:
         try:
             f = h5py.File(self.path, "r")
         except OSError as exc:
-            raise ArchiveError(f"archive {self.path} cannot be opened: {_first_line(exc)}") from None
+            raise ArchiveError(
+                f"archive {self.path} cannot be opened: {_first_line(exc)}"
+            ) from None
         with f:
             try:
                 if f.attrs.get("format") != FORMAT:
@@ -297,7 +303,9 @@ class Archive:
             group = f[name]
             self._check_seal(group)
             columns = {
-                k: self._read(f, f"{name}/scenes/{k}") for k in group["scenes"] if k != "plate_label"
+                k: self._read(f, f"{name}/scenes/{k}")
+                for k in group["scenes"]
+                if k != "plate_label"
             }
             labels = json.loads(group.attrs["plate_labels"])
             index = self._read(f, f"{name}/scenes/plate_label")
@@ -351,7 +359,9 @@ class Archive:
             craters = trajectory = None
             if "crater" in f[base]:
                 path = f"{base}/crater"
-                craters = self._read_ragged(f, path, "counts", ["impact_point"], list(CRATER_FIELDS))
+                craters = self._read_ragged(
+                    f, path, "counts", ["impact_point"], list(CRATER_FIELDS)
+                )
             if "trajectory" in f[base]:
                 path = f"{base}/trajectory"
                 trajectory = self._read_ragged(f, path, "count", [], list(TRAJECTORY_FIELDS))

@@ -25,12 +25,18 @@ import numpy as np
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
 from ..errors import ShotDataError
-from ..results import Outcome
+from ..parameters import Parameter
+from ..results import RESULT_FIELDS, Outcome
+from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
 from ..units import deg
 
-REQUIRED_COLUMNS = ("impact_speed_m_s", "impact_obliquity_deg", "residual_speed_m_s")
-OPTIONAL_COLUMNS = ("exit_obliquity_deg", "outcome")
+RESIDUAL_SPEED = Parameter(
+    "residual_speed", "speed after perforating (0: the sphere did not perforate)", "m/s"
+)
+#: The CSV columns, named as the declarations of what they hold name them.
+REQUIRED_COLUMNS = (IMPACT_SPEED.key, IMPACT_OBLIQUITY.key, RESIDUAL_SPEED.key)
+OPTIONAL_COLUMNS = (RESULT_FIELDS["exit_obliquity"].key, "outcome")
 
 
 @attrs.frozen(eq=False)
@@ -180,7 +186,11 @@ def _number(value: object) -> float:
     """A float from a number or a string; ValueError for anything else."""
     if isinstance(value, bool):
         raise ValueError
-    return float(value.strip()) if isinstance(value, str) else float(value)
+    if isinstance(value, str):
+        return float(value.strip())
+    if isinstance(value, int | float | np.integer | np.floating):
+        return float(value)
+    raise ValueError
 
 
 def _is_blank(value: object) -> bool:
@@ -244,7 +254,7 @@ def _check_row(row: Mapping[str, object]) -> tuple[list[float | int], tuple[str,
     return [speed, obliquity, residual, exit_obliquity, outcome], None
 
 
-def _parse_rows(rows: list[Mapping[str, object]], labels: list[str], source: str) -> Shots:
+def _parse_rows(rows: Sequence[Mapping[str, object]], labels: list[str], source: str) -> Shots:
     if not rows:
         raise ShotDataError(f"{source}: no shots after the header")
     parsed, problems = [], []
