@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import importlib
+import types
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,45 @@ def with_third_party(monkeypatch):
     pi.default_registry.cache_clear()
     yield
     pi.default_registry.cache_clear()
+
+
+@pytest.fixture(scope="session")
+def docs_plugins() -> dict[str, object]:
+    """The Python blocks of docs/plugins.md, run in order in one namespace (the third-party
+    package importable, as the page assumes it installed)."""
+    import re
+    import sys
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "plugins.md").read_text()
+    namespace: dict[str, object] = {"__name__": "docs_plugins"}
+    sys.path.insert(0, str(THIRD_PARTY))
+    importlib.invalidate_caches()
+    try:
+        for block in re.findall(r"```python\n(.*?)```", text, re.S):
+            exec(compile(block, "docs/plugins.md", "exec"), namespace)
+    finally:
+        sys.path.remove(str(THIRD_PARTY))
+        pi.default_registry.cache_clear()
+    return namespace
+
+
+@pytest.fixture(scope="session")
+def docs_registry(docs_plugins: dict[str, object]) -> pi.PluginRegistry:
+    """The installed plug-ins and the integrator and failure model of docs/plugins.md."""
+
+    @pi.hookimpl
+    def plateimpact_register(registry: pi.PluginRegistry) -> None:
+        registry.add(docs_plugins["ClassicalRungeKutta"])
+        registry.add(docs_plugins["SpeedDependentPlugging"])
+
+    return pi.load_registry(
+        plugins=[types.SimpleNamespace(plateimpact_register=plateimpact_register)]
+    )
+
+
+#: Every built-in integrator and the one written in docs/plugins.md: the event tests
+#: run on each (through ``docs_registry``).
+EVERY_INTEGRATOR = ["dopri5", "segment", "solve_ivp", "rk4"]
 
 
 def sweep(

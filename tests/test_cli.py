@@ -8,8 +8,10 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
+import plateimpact as pi
 from plateimpact import presets
 from plateimpact.cli import SWEEP_COLUMNS, main
 
@@ -35,31 +37,69 @@ def test_run_json_has_the_documented_fields(capsys):
     assert out["model"]["integrator"] == "dopri5"
 
 
-def test_run_overrides_match_the_python_api(capsys):
-    # A custom plate equal to the preset gives the preset's answer.
-    p = presets.plate("2024-T3/6.35")
-    custom = [
-        "run",
-        "--speed",
-        "500",
-        "--obliquity",
-        "30",
-        "--thickness",
-        "6.35",
-        "--a",
-        repr(p.a),
-        "--b",
-        repr(p.b),
-        "--pstar",
-        "6.4",
-        "--alpha",
-        "45",
-        "--json",
-    ]
-    main(custom)
-    main([*RUN, "--json"])
-    first, second = (json.loads(line) for line in capsys.readouterr().out.splitlines())
-    assert first["exit_speed_m_s"] == pytest.approx(second["exit_speed_m_s"], rel=1e-12)
+CASES = [
+    # (command-line options, plate changes [SI], plug-in names and settings for Python)
+    ([], {}, {}),
+    (
+        ["--pstar", "5.1", "--alpha", "40", "--set", "integrator.rtol=1e-9"],
+        {"critical_penetration": 5.1e-3, "failure_angle": np.radians(40.0)},
+        {"integrator_settings": {"rtol": 1e-9}},
+    ),
+    (
+        ["--failure", "hinge", "--set", "failure.finger_area_scale=0.5"],
+        {},
+        {"failure": "hinge", "failure_settings": {"finger_area_scale": 0.5}},
+    ),
+    (
+        ["--integrator", "segment", "--step", "2e-3", "--set", "model.rest_speed_fraction=0.02"],
+        {},
+        {
+            "integrator": "segment",
+            "integrator_settings": {"step": 2e-3},
+            "rest_speed_fraction": 0.02,
+        },
+    ),
+    (
+        ["--a", "8e8", "--b", "1100", "--radius", "2.5"],
+        {"a": 8e8, "b": 1100.0},
+        {},
+    ),
+]
+
+
+@pytest.mark.parametrize(("options", "plate_changes", "model"), CASES)
+def test_cli_run_is_the_python_api(options, plate_changes, model, capsys):
+    assert main([*RUN, "--json", *options]) == 0
+    out = json.loads(capsys.readouterr().out)
+    plate = presets.plate("2024-T3/6.35").with_constants(**plate_changes)
+    sphere = presets.DEFAULT_SPHERE
+    if "--radius" in options:  # a new radius keeps the default sphere's density
+        sphere = pi.Sphere.of_density(2.5e-3, presets.SAE_52100_DENSITY)
+    simulation = pi.Simulation.from_names(**model)
+    expected = simulation.run(pi.Scene(sphere, plate, 500.0, np.radians(30.0)))
+    for key, value in expected.as_user_dict().items():
+        assert out[key] == value, key  # the same numbers, to the last bit
+    assert out["model"] == json.loads(json.dumps(simulation.describe()))
+
+
+def test_cli_sweep_is_the_python_api(capsys):
+    args = ["sweep", "--preset", "SAE1010/1.47", "--speeds", "200:1200:6", "--obliquities", "0,45"]
+    assert main([*args, "--failure", "variable-pstar"]) == 0
+    rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
+    batch = pi.SceneBatch.grid(
+        presets.DEFAULT_SPHERE,
+        presets.plate("SAE1010/1.47"),
+        np.linspace(200.0, 1200.0, 6),
+        np.radians([0.0, 45.0]),
+    )
+    result = pi.Simulation.from_names(failure="variable-pstar").run_batch(batch)
+    assert len(rows) == len(result)
+    for i, row in enumerate(rows):
+        assert row["outcome"] == pi.Outcome(int(result.outcome[i])).label
+        assert float(row["exit_speed_m_s"]) == result.exit_speed[i]  # SI: the same bits
+        degrees, mm = np.degrees(result.exit_obliquity[i]), result.max_penetration[i] * 1e3
+        assert float(row["exit_obliquity_deg"]) == pytest.approx(degrees, rel=1e-15)
+        assert float(row["max_penetration_mm"]) == pytest.approx(mm, rel=1e-15)
 
 
 def test_run_writes_a_trajectory(tmp_path, capsys):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import EVERY_INTEGRATOR
 from scipy.optimize import brentq
 
 import plateimpact as pi
@@ -63,10 +64,10 @@ def test_error_shrinks_at_first_order(sphere):
     assert 0.85 < order < 1.15, (order, errors)
 
 
-@pytest.mark.parametrize("integrator", ["segment", "dopri5", "solve_ivp"])
-def test_normal_incidence_stays_on_the_normal(sphere, integrator):
+@pytest.mark.parametrize("integrator", EVERY_INTEGRATOR)
+def test_normal_incidence_stays_on_the_normal(sphere, integrator, docs_registry):
     # θ = 0 exactly: no lift, so no lateral motion at all, through failure and perforation.
-    simulation = pi.Simulation.from_names(integrator=integrator)
+    simulation = pi.Simulation.from_names(integrator=integrator, registry=docs_registry)
     for speed in (300.0, 1200.0):
         result = simulation.run(pi.Scene(sphere, PLATE, speed, 0.0), record_trajectory=True)
         assert np.all(result.trajectory.lateral == 0.0)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import plateimpact as pi
@@ -58,8 +58,7 @@ def test_malformed_command_lines_give_one_line_errors(command, options):
     for flag, value in options:
         argv += [flag] if flag == "--json" else [flag, value]
     # Keep accidental valid sweeps small: a fuzz run must not hang on a legitimate job.
-    if command == "sweep" and any(":" in v and not v.endswith(":3") for _, v in options):
-        return
+    assume(not (command == "sweep" and any(":" in v and not v.endswith(":3") for _, v in options)))
     assert_clean(*run_cli(argv))
 
 

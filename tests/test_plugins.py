@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import ast
 import json
 import os
 import subprocess
@@ -89,20 +88,3 @@ def test_unknown_names_and_settings_list_the_choices():
         registry.create("integrator", "rk99")
     with pytest.raises(pi.ParameterError, match="settings: max_steps, step"):
         registry.create("integrator", "segment", tolerance=1e-6)
-
-
-def _imports(package: Path) -> set[str]:
-    found = set()
-    for path in package.rglob("*.py"):
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-                found.add(node.module)
-            elif isinstance(node, ast.Import):
-                found.update(alias.name for alias in node.names)
-    return found
-
-
-def test_plugins_use_only_the_public_api_and_the_core_never_imports_them():
-    plugin_imports = _imports(ROOT / "plugins")
-    assert not {m for m in plugin_imports if m.startswith("plateimpact.")}
-    assert not {m for m in _imports(ROOT / "framework") if m.startswith("plateimpact_plugins")}

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
@@ -62,13 +63,17 @@ def add_parsers(sub: Any) -> None:
     p.set_defaults(command_function=plot_command)
 
 
+#: The entry-point group of runnable study collections; ``reproduce`` runs ``report``.
+STUDIES_GROUP = "plateimpact.studies"
+
+
 def reproduce_command(args: argparse.Namespace) -> None:
-    try:
-        from plateimpact_studies.reproduce import reproduce  # noqa: PLC0415
-    except ImportError:
+    found = {entry.name: entry for entry in entry_points(group=STUDIES_GROUP)}
+    if "report" not in found:
         raise UsageError(
-            "the report studies (package plateimpact_studies) are not installed"
-        ) from None
+            f"no study collection 'report' is installed (entry-point group {STUDIES_GROUP})"
+        )
+    reproduce = found["report"].load()
     out = Path(args.out)
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")

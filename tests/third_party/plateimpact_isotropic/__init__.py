@@ -41,18 +41,6 @@ REFERENCE_SPEED = Parameter(
 
 @final
 @attrs.frozen
-class IsotropicPoncelet(ResistanceLaw):
-    """σ = a + b V² [N/m²]."""
-
-    name = "isotropic-poncelet"
-    plate_constants = (STRENGTH_A, DENSITY_B)
-
-    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
-        return batch.a + batch.b * speed * speed
-
-
-@final
-@attrs.frozen
 class RatePoncelet(ResistanceLaw):
     """σ = a (1 + c ln(1 + V cos ψ / V_ref)) + b V² cos² ψ [N/m²]."""
 
@@ -66,6 +54,18 @@ class RatePoncelet(ResistanceLaw):
         rate = np.log1p(np.maximum(normal_speed, 0.0) / self.reference_speed)
         strength = batch.a * (1.0 + batch.rate_sensitivity * rate)
         return strength + batch.b * normal_speed * normal_speed
+
+
+@final
+@attrs.frozen
+class IsotropicPoncelet(ResistanceLaw):
+    """σ = a + b V² [N/m²]."""
+
+    name = "isotropic-poncelet"
+    plate_constants = (STRENGTH_A, DENSITY_B)
+
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
+        return batch.a + batch.b * speed * speed
 
 
 @hookimpl
