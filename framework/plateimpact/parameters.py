@@ -151,7 +151,9 @@ class Parameter:
             return f"one of {', '.join(self.choices)}"
         if self.kind is bool:
             return "true or false"
-        text = self.range.describe(self.scale, self.user_unit)
+        if self.convert is not None:
+            return "as described"
+        text = self.range.describe(self.scale, "" if self.user_unit == "1" else self.user_unit)
         if self.kind is int:
             text = f"an integer {text}"
         return text + (" or none" if self.optional else "")
@@ -162,7 +164,8 @@ class Parameter:
         default = ""
         if self.has_default:
             default = f"; default {self.format(self.default)}"
-        return f"{self.description}{unit}; {self.describe_range()}{default}"
+        allowed = "" if self.convert is not None else f"; {self.describe_range()}"
+        return f"{self.description}{unit}{allowed}{default}"
 
     def format(self, value: object) -> str:
         """``value`` [SI] as users write it."""

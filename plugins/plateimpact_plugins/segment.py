@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import final
+from typing import ClassVar, final
 
 import attrs
 import numpy as np
@@ -33,33 +33,44 @@ STEP = Parameter(
 )
 
 
-class Arc(DenseOutput):
-    """The segment from y with the rates at its start: after a time σ·dt the speed is
-    V + dV/dt·σdt (eq 25), the direction has turned by dθ/dt·σdt (eqs 26–28), and the
-    sphere has moved along the circular arc of that turn at the new speed (the chord of
-    eqs 29–30); the failure state moves at its start rate."""
+def arc(y: np.ndarray, rates: np.ndarray, dt: np.ndarray | float) -> np.ndarray:
+    """The state after a time dt [s] on the segment from y with the rates at its start:
+    the speed is V + dV/dt·dt (eq 25), the direction has turned by dθ/dt·dt (eqs 26–28),
+    and the sphere has moved along the circular arc of that turn at the new speed (the
+    chord of eqs 29–30); the failure state moves at its start rate."""
+    speed = y[SPEED] + rates[SPEED] * dt
+    turn = rates[OBLIQUITY] * dt
+    chord = speed * dt * np.sinc(turn / (2.0 * np.pi))  # arc of length V'dt, turning dθ
+    heading = y[OBLIQUITY] + 0.5 * turn
+    out = np.empty_like(y)
+    out[PENETRATION] = y[PENETRATION] + chord * np.cos(heading)
+    out[LATERAL] = y[LATERAL] + chord * np.sin(heading)
+    out[OBLIQUITY] = y[OBLIQUITY] + turn
+    out[SPEED] = speed
+    out[KINEMATIC_STATE:] = y[KINEMATIC_STATE:] + rates[KINEMATIC_STATE:] * dt
+    return out
 
-    __slots__ = ("dt", "rates", "y")
 
-    def __init__(self, y: np.ndarray, rates: np.ndarray, dt: np.ndarray) -> None:
-        self.y, self.rates, self.dt = y, rates, dt
+class Segments(DenseOutput):
+    """A run of k segments as one dense output: σ in [j/k, (j+1)/k] lies on segment j."""
+
+    __slots__ = ("dt", "rates", "starts")
+
+    def __init__(self, starts: np.ndarray, rates: np.ndarray, dt: np.ndarray) -> None:
+        self.starts, self.rates, self.dt = starts, rates, dt  # (k, d, n), (k, d, n), (n,)
 
     def __call__(self, sigma: float | np.ndarray) -> np.ndarray:
-        y, rates, dt = self.y, self.rates, self.dt * sigma
-        speed = y[SPEED] + rates[SPEED] * dt
-        turn = rates[OBLIQUITY] * dt
-        chord = speed * dt * np.sinc(turn / (2.0 * np.pi))  # arc of length V'dt, turning dθ
-        heading = y[OBLIQUITY] + 0.5 * turn
-        out = np.empty_like(y)
-        out[PENETRATION] = y[PENETRATION] + chord * np.cos(heading)
-        out[LATERAL] = y[LATERAL] + chord * np.sin(heading)
-        out[OBLIQUITY] = y[OBLIQUITY] + turn
-        out[SPEED] = speed
-        out[KINEMATIC_STATE:] = y[KINEMATIC_STATE:] + rates[KINEMATIC_STATE:] * dt
-        return out
+        k = self.starts.shape[0]
+        if np.ndim(sigma) == 0 and float(sigma) * k in range(1, k):  # a segment's end
+            return self.starts[int(float(sigma) * k)].copy()
+        position = np.broadcast_to(np.asarray(sigma, dtype=float) * k, self.dt.shape)
+        j = np.minimum(np.floor(position).astype(int), k - 1)
+        scene = np.arange(self.dt.size)
+        start, rate = self.starts[j, :, scene].T, self.rates[j, :, scene].T
+        return arc(start, rate, self.dt * (position - j))
 
-    def take(self, index: np.ndarray) -> Arc:
-        return Arc(self.y[:, index], self.rates[:, index], self.dt[index])
+    def take(self, index: np.ndarray) -> Segments:
+        return Segments(self.starts[:, :, index], self.rates[:, :, index], self.dt[index])
 
 
 @final
@@ -72,23 +83,34 @@ class Segment(Integrator):
     (eq 25) and the path turns by dθ = F_L dt/(m V) (eqs 26–28); the sphere then moves
     along the circular arc of that turn at the new speed V' ("from the new values for
     speed and curvature", step 4), which gives eqs 29–30 to first order. The method is
-    first order in dt. The driver locates events on the arc, so a segment that crosses
+    first order in dt. The driver locates events on the arcs, so a segment that crosses
     P*, the rest speed or the end of contact ends there.
+
+    The driver sees ``SEGMENTS`` segments as one step, sampled at every segment's end:
+    the same segments, events and trajectory, with the driver's bookkeeping spread over
+    them (segments computed past an event are discarded); ``max_steps`` counts such steps.
     """
 
     name = "segment"
     version = "2"
-    #: A segment is short: its ends are enough to see an event in it.
-    event_samples = 2
+    #: Segments per driver step; the driver looks for events at each one's end.
+    SEGMENTS: ClassVar[int] = 8
+    event_samples = SEGMENTS + 1
 
     step: float = STEP.field()
-    max_steps: int = attrs.evolve(MAX_STEPS, default=20_000_000).field()
+    max_steps: int = attrs.evolve(MAX_STEPS, default=2_500_000).field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
-        return self.step * dynamics.time_scale
+        return self.SEGMENTS * self.step * dynamics.time_scale
 
     def advance(
         self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray, h: np.ndarray, state: StepperState
     ) -> Step:
-        arc = Arc(y, dynamics.rates(y), h)
-        return Step(arc(1.0), h, None, arc, state)
+        dt = h / self.SEGMENTS
+        starts = np.empty((self.SEGMENTS, *y.shape))
+        rates = np.empty_like(starts)
+        current = y
+        for j in range(self.SEGMENTS):
+            starts[j], rates[j] = current, dynamics.rates(current)
+            current = arc(current, rates[j], dt)
+        return Step(current, h, None, Segments(starts, rates, dt), state)

@@ -171,7 +171,8 @@ def _to_table(value: object) -> PstarTable:
 PSTAR_TABLE = Parameter(
     "table",
     "P* by impact obliquity and speed: a PstarTable, its rows, or a CSV file with columns "
-    + ",".join(TABLE_COLUMNS),
+    + ",".join(TABLE_COLUMNS)
+    + " (none: the report's SAE 1010 values)",
     default=None,
     flag="--pstar-table",
     convert=lambda value: _to_table(SAE1010_TABLE if value is None else value),

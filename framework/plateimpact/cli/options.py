@@ -35,6 +35,14 @@ def _dest(flag: str) -> str:
     return flag.lstrip("-").replace("-", "_")
 
 
+def metavar(declared: Parameter) -> str:
+    """What a flag's value is called in help: its unit, or its name if it has none."""
+    unit = declared.user_unit
+    if unit == "1":
+        return declared.name.upper()
+    return unit.upper().replace("/", "_").replace("^", "")
+
+
 def _aliases(registry: PluginRegistry) -> dict[str, tuple[str, str, list[tuple[str, Parameter]]]]:
     """Setting flags declared by plug-ins: flag -> (kind, setting, [(plug-in, declaration)])."""
     found: dict[str, tuple[str, str, list[tuple[str, Parameter]]]] = {}
@@ -74,9 +82,7 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
         owners = "; ".join(f"{name}: default {d.format(d.default)}" for name, d in declarers)
         declared = declarers[0][1]
         help_text = f"--set {kind}.{setting}=: {declared.description} ({owners})"
-        group.add_argument(
-            flag, dest=_dest(flag), metavar=declared.user_unit.upper(), help=help_text
-        )
+        group.add_argument(flag, dest=_dest(flag), metavar=metavar(declared), help=help_text)
 
 
 def add_body_options(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None:
@@ -94,12 +100,13 @@ def add_body_options(parser: argparse.ArgumentParser, registry: PluginRegistry) 
         group.add_argument(
             declared.flag,
             dest=_dest(declared.flag or ""),
-            metavar=declared.user_unit.upper().replace("/", "_").replace("^", ""),
+            metavar=metavar(declared),
             help=declared.help(),
         )
     sphere = presets.DEFAULT_SPHERE
-    group.add_argument("--radius", help=f"{RADIUS.help()} (default {sphere.radius * 1e3:.4g})")
-    group.add_argument("--mass", help=f"{MASS.help()} (default {sphere.mass * 1e3:.4f})")
+    for declared, value in ((RADIUS, sphere.radius), (MASS, sphere.mass)):
+        help_text = f"{declared.help()} (default {declared.format(value)})"
+        group.add_argument(declared.flag or "", metavar=metavar(declared), help=help_text)
 
 
 def _constant_flags(registry: PluginRegistry) -> dict[str, Parameter]:

@@ -15,7 +15,15 @@ from ..registry import PluginRegistry
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from .common import UsageError, check_directory, csv_text, save_figure_atomically, write_atomically
-from .options import add_body_options, add_model_options, bodies, model_choice, scene_flags, typed
+from .options import (
+    add_body_options,
+    add_model_options,
+    bodies,
+    metavar,
+    model_choice,
+    scene_flags,
+    typed,
+)
 
 #: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
 SWEEP_COLUMNS = (
@@ -28,33 +36,31 @@ SWEEP_COLUMNS = (
 
 
 def add_parsers(sub: Any, registry: PluginRegistry) -> None:
-    p = sub.add_parser("run", help="run one scene")
-    p.add_argument("--speed", required=True, help=IMPACT_SPEED.help())
-    p.add_argument("--obliquity", required=True, help=IMPACT_OBLIQUITY.help())
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--trajectory", metavar="FILE", help="write the trajectory as CSV")
-    add_body_options(p, registry)
-    add_model_options(p, registry)
-    p.set_defaults(command_function=run_command)
-
-    p = sub.add_parser("crater", help="the crater section of one scene (eqs 31-39)")
-    p.add_argument("--speed", required=True, help=IMPACT_SPEED.help())
-    p.add_argument("--obliquity", required=True, help=IMPACT_OBLIQUITY.help())
-    p.add_argument("--csv", metavar="FILE", help="write lateral_mm,depth_mm here")
-    p.add_argument("--png", metavar="FILE", help="draw the crater here")
-    add_body_options(p, registry)
-    add_model_options(p, registry)
-    p.set_defaults(command_function=crater_command)
-
-    p = sub.add_parser("sweep", help="run a grid of speeds and obliquities")
-    p.add_argument(
-        "--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a comma list"
-    )
-    p.add_argument("--obliquities", required=True, help="impact obliquities [deg], a comma list")
-    p.add_argument("--csv", metavar="FILE", help="write CSV here (default: standard output)")
-    add_body_options(p, registry)
-    add_model_options(p, registry)
-    p.set_defaults(command_function=sweep_command)
+    commands = [
+        ("run", run_command, "run one scene"),
+        ("crater", crater_command, "the crater section of one scene (eqs 31-39)"),
+        ("sweep", sweep_command, "run a grid of speeds and obliquities"),
+    ]
+    parsers = {}
+    for name, function, summary in commands:
+        p = parsers[name] = sub.add_parser(name, help=summary)
+        if name == "sweep":
+            p.add_argument(
+                "--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a list"
+            )
+            p.add_argument("--obliquities", required=True, help="impact obliquities [deg], a list")
+        else:
+            for declared in (IMPACT_SPEED, IMPACT_OBLIQUITY):
+                flag = declared.flag or ""
+                p.add_argument(flag, required=True, metavar=metavar(declared), help=declared.help())
+        add_body_options(p, registry)
+        add_model_options(p, registry)
+        p.set_defaults(command_function=function)
+    parsers["run"].add_argument("--json", action="store_true", help="print one JSON object")
+    parsers["run"].add_argument("--trajectory", metavar="FILE", help="write the trajectory as CSV")
+    parsers["crater"].add_argument("--csv", metavar="FILE", help="write lateral_mm,depth_mm here")
+    parsers["crater"].add_argument("--png", metavar="FILE", help="draw the crater here")
+    parsers["sweep"].add_argument("--csv", metavar="FILE", help="write CSV here (default: stdout)")
 
 
 def _scene(args: argparse.Namespace) -> tuple[Scene, Any, str]:
