@@ -78,9 +78,9 @@ def main() -> None:
     model = simulation.model
     bound = model.bind(batch)
     rng = np.random.default_rng(1)
-    pen = rng.uniform(0.0, 2.0, batch.size) * bound.radius
+    pen = rng.uniform(0.0, 2.0, batch.size) * bound.core.radius
     obl = rng.uniform(0.0, np.pi / 2, batch.size)
-    spd = bound.impact_speed * rng.uniform(0.1, 1.0, batch.size)
+    spd = bound.core.impact_speed * rng.uniform(0.1, 1.0, batch.size)
     state = model.new_failure_state(batch.size)
     some = rng.uniform(size=batch.size) < 0.2
     every = np.ones(batch.size, bool)

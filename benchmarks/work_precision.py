@@ -1,6 +1,6 @@
 """Work-precision of every integrator on 500 seeded scenes.
 
-Reference: solve_ivp DOP853 at rtol 1e-12, cross-checked by dopri5 at rtol 1e-12 (their
+Reference: solve_ivp DOP853 at rtol 1e-13, cross-checked by dopri5 at rtol 1e-13 (their
 largest disagreement is printed). For each integrator and tolerance (or step): max and
 median error of exit speed relative to impact speed, max and median error of exit
 obliquity [deg] (embedments excluded), outcome mismatches, time per scene (minimum of
@@ -25,6 +25,11 @@ import plateimpact as pi
 from plateimpact import plotting
 
 RESULTS = Path(__file__).resolve().parent / "results"
+#: The reference's tolerance. solve_ivp steps across the force's branch surfaces (it has
+#: no branch landing), where its error estimate is unreliable: at 1e-12 one scene of the
+#: set left the reference 1.5e-6 deg off in exit obliquity, a floor above dopri5's own
+#: errors at rtol 1e-10; at 1e-13 the two references agree to 1e-7 deg.
+REFERENCE_RTOL = 1e-13
 #: (series, integrator, settings). "dopri5, straddling" is dopri5 without stepping onto
 #: the force's branch surfaces (branch_landing=False), the default until this benchmark
 #: showed what landing saves.
@@ -57,22 +62,29 @@ def timed(simulation, batch, repeats):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", type=int, default=500)
+    parser.add_argument(
+        "--plot-only", action="store_true", help="redraw the figure from results/work_precision.csv"
+    )
     args = parser.parse_args()
+    if args.plot_only:
+        with open(RESULTS / "work_precision.csv", newline="") as handle:
+            plot([tuple(row) for row in list(csv.reader(handle))[1:]], args.scenes)
+        return
     batch = benchmark_batch(args.scenes)
     speed = batch.impact_speed
 
     start = time.perf_counter()
     reference = pi.Simulation.from_names(
-        integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
+        integrator="solve_ivp", integrator_settings={"rtol": REFERENCE_RTOL}
     ).run_batch(batch)
-    print(f"reference DOP853 rtol 1e-12: {time.perf_counter() - start:.0f} s")
-    check = pi.Simulation.from_names(integrator_settings={"rtol": 1e-12}).run_batch(batch)
+    print(f"reference DOP853 rtol {REFERENCE_RTOL:g}: {time.perf_counter() - start:.0f} s")
+    check = pi.Simulation.from_names(integrator_settings={"rtol": REFERENCE_RTOL}).run_batch(batch)
     flying = (reference.outcome != pi.Outcome.EMBEDMENT) & (check.outcome != pi.Outcome.EMBEDMENT)
     obliquity_gap = np.degrees(
         np.max(np.abs(check.exit_obliquity - reference.exit_obliquity)[flying])
     )
     print(
-        "cross-check dopri5 rtol 1e-12: outcome mismatches "
+        f"cross-check dopri5 rtol {REFERENCE_RTOL:g}: outcome mismatches "
         f"{int(np.sum(check.outcome != reference.outcome))}, max |Δ exit speed|/Vs "
         f"{np.max(np.abs(check.exit_speed - reference.exit_speed) / speed):.1e}, max |Δ exit "
         f"obliquity| {obliquity_gap:.1e} deg"
@@ -129,14 +141,20 @@ def main() -> None:
         writer.writerow(header)
         writer.writerows(rows)
 
-    fig, axes = plotting.plt.subplots(1, 2, figsize=(12, 4.8))
+    plot(rows, batch.size)
+    print(f"wrote {RESULTS / 'work_precision.csv'} and work_precision.png")
+
+
+def plot(rows: list[tuple], scenes: int) -> None:
+    """The work-precision diagram of ``rows`` (as in the CSV) into results/."""
+    fig, axes = plotting.figure(1, 2, figsize=(12, 4.8))
     for series in dict.fromkeys(r[0] for r in rows):
         points = [r for r in rows if r[0] == series]
         style = "s--" if "straddling" in series else "o-"
         for ax, column in zip(axes, (4, 6), strict=True):
             ax.loglog(
-                [max(r[column], 1e-16) for r in points],
-                [r[9] for r in points],
+                [max(float(r[column]), 1e-16) for r in points],
+                [float(r[9]) for r in points],
                 style,
                 label=series,
             )
@@ -149,11 +167,10 @@ def main() -> None:
     axes[1].axvline(1e-4, color="0.5", ls=":")
     axes[0].legend()
     fig.suptitle(
-        f"Work-precision, {batch.size} scenes (reference: DOP853 at rtol 1e-12); "
+        f"Work-precision, {scenes} scenes (reference: DOP853 at rtol {REFERENCE_RTOL:g}); "
         "dotted: the default's targets"
     )
     plotting.save(fig, str(RESULTS / "work_precision.png"))
-    print(f"wrote {RESULTS / 'work_precision.csv'} and work_precision.png")
 
 
 if __name__ == "__main__":

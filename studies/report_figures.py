@@ -32,7 +32,7 @@ def figure_30_31(out: Path) -> Path:
     plate = presets.plate("2024-T3/3.18")
     speeds = np.linspace(50.0, 1500.0, 146)
     simulation = pi.Simulation.from_names()
-    fig, axes = plotting.plt.subplots(2, 1, figsize=(7, 7), sharex=True)
+    fig, axes = plotting.figure(2, 1, figsize=(7, 7), sharex=True)
     for p, style, label in [
         (plate, {"color": "C0"}, f"P* = {plate.critical_penetration / mm:g} mm"),
         (
@@ -61,7 +61,7 @@ def figure_30_31(out: Path) -> Path:
 def figure_35(out: Path) -> Path:
     plate = presets.plate("6061-T6/9.53")
     simulation = pi.Simulation.from_names()
-    fig, axes = plotting.plt.subplots(2, 1, figsize=(8, 7), layout="constrained")
+    fig, axes = plotting.figure(2, 1, figsize=(8, 7), layout="constrained")
     for ax, speed in zip(axes, (263.0, 737.0), strict=True):
         result = simulation.run(pi.Scene(SPHERE, plate, speed, 60 * deg), record_trajectory=True)
         section = crater_section(result.trajectory, SPHERE.radius, thickness=plate.thickness)
@@ -88,8 +88,8 @@ def hinge_geometry(out: Path) -> Path:
     t = result.trajectory
     beta = t.failure_state["finger_angle"]
     failed = np.flatnonzero(np.isfinite(beta))
-    batch = simulation.model.bind(pi.SceneBatch.from_scenes([scene]))
-    theta1 = batch.hinge_obliquity[0]
+    batch = simulation.model.bind(pi.SceneBatch.from_scenes([scene])).failure  # hinge's view
+    theta1 = batch.theta1[0]
     release = failed[np.argmax(t.obliquity[failed] > theta1)]
     moments = [
         (failed[0], "failure onset: β = 2α* held"),
@@ -97,7 +97,7 @@ def hinge_geometry(out: Path) -> Path:
         (failed[-1], "perforation"),
     ]
     h = batch.failure_plane_depth[0]
-    fig, axes = plotting.plt.subplots(1, 3, figsize=(13, 4.6))
+    fig, axes = plotting.figure(1, 3, figsize=(13, 4.6))
     rs = SPHERE.radius / mm
     circle = np.linspace(0, 2 * np.pi, 241)
     for ax, (i, title) in zip(axes, moments, strict=True):

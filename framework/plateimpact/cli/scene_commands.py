@@ -22,7 +22,6 @@ from .options import (
     metavar,
     model_choice,
     scene_flags,
-    typed,
 )
 
 #: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
@@ -165,7 +164,6 @@ def sweep_command(args: argparse.Namespace) -> None:
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)
     speeds, obliquities = _parse_speeds(args.speeds), _parse_obliquities(args.obliquities)
-    typed(args)
     batch = SceneBatch.grid(sphere, plate, speeds, obliquities * IMPACT_OBLIQUITY.scale)
     result = simulation.run_batch(batch)
     # Echo the values as typed (the grid is obliquity-major), not their round trip via SI.
