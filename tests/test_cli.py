@@ -285,9 +285,10 @@ def test_pstar_table_from_the_command_line(tmp_path, capsys):
         "--json",
     ]
     assert main([*base, "--failure", "variable-pstar", "--pstar-table", str(good)]) == 0
+    assert main([*base, "--failure", "variable-pstar", "--set", f"failure.table={good}"]) == 0
     assert main([*base, "--pstar", "3.0"]) == 0
-    variable, constant = (json.loads(x) for x in capsys.readouterr().out.splitlines())
-    assert variable["exit_speed_m_s"] == constant["exit_speed_m_s"]
+    variable, generic, constant = (json.loads(x) for x in capsys.readouterr().out.splitlines())
+    assert variable["exit_speed_m_s"] == generic["exit_speed_m_s"] == constant["exit_speed_m_s"]
 
     bad = tmp_path / "bad.csv"
     bad.write_text(

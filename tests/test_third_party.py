@@ -94,6 +94,7 @@ def test_from_the_command_line_set_and_the_declared_flag_match_python(with_third
     model = ["--resistance", "rate-poncelet", "--set", "integrator.rtol=1e-10"]
     ways = [
         ["--set", "resistance.rate_sensitivity=0.3", "--set", "resistance.reference_speed=50"],
+        ["--set", "resistance.c=0.3", "--set", "resistance.reference_speed=50"],
         ["--c", "0.3", "--set", "resistance.reference_speed=50"],
         ["--set", "plate.rate_sensitivity=0.3", "--set", "resistance.reference_speed=50"],
     ]

@@ -11,6 +11,7 @@ and the flag an error names all come from the same declarations.
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterable
 from typing import Any
 
 import attrs
@@ -114,6 +115,13 @@ def _constant_flags(registry: PluginRegistry) -> dict[str, Parameter]:
     return {name: p for name, p in registry.plate_constants.items() if p.flag}
 
 
+def _by_name_or_short(declarations: Iterable[Parameter]) -> dict[str, Parameter]:
+    """Plate constants by name, and by the short name of their file key (``c``)."""
+    found = {p.short: p for p in declarations if p.short}
+    found.update({p.name: p for p in declarations})
+    return found
+
+
 def typed(args: argparse.Namespace) -> dict[str, str]:
     """Parameter name -> the flag the user typed for it (for error messages)."""
     flags: dict[str, str] = getattr(args, TYPED_FLAGS, {})
@@ -157,19 +165,21 @@ class ModelChoice:
             self.model[name] = _parse(REST_SPEED_FRACTION, text, flag, args)
             return
         if slot == "plate":
-            declared = THICKNESS if name == "thickness" else self.registry.plate_constants.get(name)
+            known_constants = _by_name_or_short(self.registry.plate_constants.values())
+            declared = THICKNESS if name == "thickness" else known_constants.get(name)
             if declared is None:
                 known = ", ".join(["thickness", *self.registry.plate_constants])
                 raise UsageError(f"{flag}: no plate constant {name!r}; plate constants: {known}")
-            self.plate[name] = _parse(declared, text, flag, args)
-            self.plate_flags[name] = flag
+            self.plate[declared.name] = _parse(declared, text, flag, args)
+            self.plate_flags[declared.name] = flag
             return
         cls = self.registry.get(slot, self.names[slot])
         settings = cls.setting_declarations()
-        constants = {p.name: p for p in cls.plate_constants}
-        if name in constants:
-            self.plate[name] = _parse(constants[name], text, flag, args)
-            self.plate_flags[name] = flag
+        constants = _by_name_or_short(cls.plate_constants)
+        if name in constants and name not in settings:
+            declared = constants[name]
+            self.plate[declared.name] = _parse(declared, text, flag, args)
+            self.plate_flags[declared.name] = flag
         elif name in settings:
             self.settings[slot][name] = _parse(settings[name], text, flag, args)
         else:
