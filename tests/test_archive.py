@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -170,21 +170,44 @@ def test_resume_reads_back_finished_runs_and_runs_the_rest(tmp_path):
     assert with_craters["coarse"].craters is not None and archive.runs()[-1] == "r/coarse.2"
 
 
-def test_a_live_writer_is_reported_and_a_dead_one_is_not(tmp_path):
+HOLD_LOCK = """
+import sys
+from pathlib import Path
+from plateimpact.storage.lock import locked
+path = Path(sys.argv[1])
+lock = path.with_name(path.name + ".lock")
+with locked(path, path, lock, wait=0.0):
+    print("locked", flush=True)
+    sys.stdin.readline()  # hold the lock until the test closes our stdin
+"""
+
+
+def test_a_live_writer_makes_others_wait_or_save_aside_and_readers_read(tmp_path):
+    """A writer holding the lock (another process, holding it until told) does not stop
+    readers (the file they open is always whole), makes a writer that cannot wait save
+    its run beside the archive and say where, and once it is gone the archive takes
+    runs again. A lock file left by a dead writer holds nothing: the kernel let go."""
     path = tmp_path / "a.h5"
-    small_study().run(archive=path)
-    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
-    lock = path.with_name(path.name + ".lock")
+    study = small_study()
+    results = study.run(archive=path)
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLD_LOCK, str(path)], stdin=subprocess.PIPE, stdout=subprocess.PIPE
+    )
     try:
-        lock.write_text(f"{sleeper.pid} {os.uname().nodename}\n")
-        with pytest.raises(pi.ArchiveError, match=f"being written by process {sleeper.pid}"):
-            pi.Archive(path).runs()
+        assert holder.stdout.readline() == b"locked\n"
+        assert len(pi.Archive(path).runs()) == 2
+        impatient = pi.Archive(path, wait=0.0)
+        with pytest.raises(pi.ArchiveError, match=f"process {holder.pid} on .*saved to ") as info:
+            impatient.append_run(study, study.variants[0], results["plugging"], {"note": "x"})
+        side = pathlib.Path(str(info.value).rsplit("saved to ", 1)[1])
+        assert side.parent == tmp_path and pi.Archive(side).runs() == ["t318/plugging"]
+        assert_same(results["plugging"], pi.Archive(side).results("plugging"))
+        assert len(pi.Archive(path).runs()) == 2  # the archive itself untouched
     finally:
-        sleeper.kill()
-        sleeper.wait()
-    assert len(pi.Archive(path).runs()) == 2  # the lock is stale now: the archive opens
-    small_study().run(archive=path)  # and takes new runs
-    assert not lock.exists()
+        holder.stdin.close()
+        holder.wait()
+    study.run(archive=path)  # the lock is free again (its file stays, naming the last writer)
+    assert len(pi.Archive(path).runs()) == 4
 
 
 def flip_bytes(path, dataset):

@@ -9,7 +9,9 @@ draw on axes you pass and return them; :func:`figure` gives a figure and its axe
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import matplotlib
@@ -18,6 +20,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from .results import BatchResult, CraterSection, Outcome, Trajectory
+from .storage.output import write_output
 
 if TYPE_CHECKING:
     from .calibration import DriFit
@@ -155,9 +158,16 @@ def plot_calibration(
     return ax
 
 
-def save(fig: Figure, path: str) -> None:
-    """Save a figure [PNG by the file's extension]."""
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+def save(fig: Figure, path: str | os.PathLike[str], flag: str = "figure") -> None:
+    """Save a figure, its format from the file's extension (PNG, SVG, PDF, ...), all of it
+    or nothing: written beside the target and renamed over it (storage.output)."""
+    suffix = Path(path).suffix.lower().lstrip(".")
+    write_output(
+        path,
+        flag,
+        lambda handle: fig.savefig(handle, format=suffix, dpi=DPI, bbox_inches="tight"),
+        kind="figure",
+    )
 
 
 def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> Figure:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from concurrent.futures import Executor
 from pathlib import Path
@@ -20,6 +21,7 @@ from .results import BatchResult, Outcome
 from .scene import Scene
 from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
 from .storage.archive import Archive
+from .storage.lock import ArchiveBusyError, ArchiveWaitWarning
 from .storage.provenance import RunMetadata
 from .variant import Variant, check_name
 
@@ -209,7 +211,12 @@ class Study:
                 metadata.finish()
                 runs[variant.name] = result
                 if writer is not None:
-                    writer.append_run(self, variant, result, metadata.as_attributes(), constants)
+                    try:
+                        writer.append_run(
+                            self, variant, result, metadata.as_attributes(), constants
+                        )
+                    except ArchiveBusyError as exc:  # the run was saved aside: say where
+                        warnings.warn(str(exc), ArchiveWaitWarning, stacklevel=2)
         return StudyResults(self, runs)
 
 

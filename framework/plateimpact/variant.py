@@ -33,10 +33,14 @@ def _settings(value: dict[str, Any] | None) -> dict[str, Any]:
 
 
 def check_name(instance: object, attribute: attrs.Attribute, value: object) -> None:
-    """A study or run name: non-empty, no '/', no surrounding space."""
-    if not isinstance(value, str) or not value or "/" in value or value != value.strip():
+    """A study or run name, which names an archive group: non-empty, printable (no NUL,
+    which HDF5 would cut the name at), no '/', no surrounding space."""
+    name = value if isinstance(value, str) else ""
+    if not name or name != name.strip() or "/" in name or not name.isprintable():
         raise ParameterError(
-            attribute.name, f"{attribute.name} must be a non-empty name without '/', got {value!r}"
+            attribute.name,
+            f"{attribute.name} must be a printable name without '/' or surrounding space, "
+            f"got {value!r}",
         )
 
 

@@ -94,14 +94,20 @@ class PstarTable:
     def from_csv(cls, path: str | os.PathLike[str]) -> PstarTable:
         """A table from a CSV file with the header of :data:`TABLE_COLUMNS` (any order)."""
         try:
-            with open(path, newline="") as handle:
+            with open(path, encoding="utf-8-sig", newline="") as handle:  # a BOM is allowed
                 reader = csv.DictReader(handle)
-                missing = set(TABLE_COLUMNS) - set(reader.fieldnames or ())
+                names = [name.strip() for name in reader.fieldnames or ()]
+                missing = set(TABLE_COLUMNS) - set(names)
                 if missing:
                     raise _fail(f"{path}: missing columns {', '.join(sorted(missing))}")
+                reader.fieldnames = names
                 rows = [[line[c] for c in TABLE_COLUMNS] for line in reader]
         except OSError as exc:
             raise _fail(f"cannot read {path}: {exc.strerror}") from None
+        except UnicodeDecodeError:
+            raise _fail(f"cannot read {path}: not UTF-8 text") from None
+        except csv.Error as exc:
+            raise _fail(f"{path}: not a CSV table ({exc})") from None
         return cls.from_rows(rows)
 
     @classmethod

@@ -75,6 +75,10 @@ def reproduce_command(args: argparse.Namespace) -> None:
         )
     reproduce = found["report"].load()
     out = Path(args.out)
+    if not str(args.out).strip():
+        raise UsageError("--out: give a directory name")
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out: {args.out!r} exists and is not a directory")
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
     archive, figures = reproduce(out, resume=args.resume)
@@ -123,7 +127,7 @@ def show_command(args: argparse.Namespace) -> None:
 
 
 def compare_command(args: argparse.Namespace) -> None:
-    check_directory(args.png, "--png")
+    check_directory(args.png, "--png", "figure")
     archive = Archive(args.archive)
     results = _study_results(archive, [args.run_a, args.run_b])
     name_a, name_b = archive.resolve(args.run_a), archive.resolve(args.run_b)
@@ -141,13 +145,13 @@ def compare_command(args: argparse.Namespace) -> None:
     if args.png:
         from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
-        plotting.save(plotting.plot_study(results), args.png)
+        plotting.save(plotting.plot_study(results), args.png, "--png")
 
 
 def plot_command(args: argparse.Namespace) -> None:
     from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
-    check_directory(args.out, "--out")
+    check_directory(args.out, "--out", "figure")
     for speed in args.speed or ():
         if not (math.isfinite(speed) and speed > 0.0):
             raise UsageError(f"--speed must be a finite impact speed > 0 m/s, got {speed}")
@@ -159,5 +163,5 @@ def plot_command(args: argparse.Namespace) -> None:
             figure = plotting.plot_study_paths(results, kind=args.kind, speeds=args.speed)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
-    plotting.save(figure, args.out)
+    plotting.save(figure, args.out, "--out")
     print(f"figure: {args.out}")

@@ -61,7 +61,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
 def calibrate_command(args: argparse.Namespace) -> None:
     """Run ``plateimpact calibrate``."""
     check_directory(args.out, "--out")
-    check_directory(args.png, "--png")
+    check_directory(args.png, "--png", "figure")
     shots = Shots.from_csv(args.shots)
     choice = model_choice(args)
     simulation = choice.simulation()

@@ -5,12 +5,12 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import os
-import tempfile
+import sys
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
+from ..storage.output import OutputError, check_output, write_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -31,42 +31,35 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"plateimpact: error: {message}\n")
 
 
-def check_directory(path: str | None, flag: str) -> None:
-    """Refuse an output path in a missing directory before any work is done."""
-    if path is not None and not os.path.isdir(os.path.dirname(os.path.abspath(path))):
-        raise UsageError(
-            f"{flag}: directory {os.path.dirname(os.path.abspath(path))!r} does not exist"
-        )
+def check_directory(path: str | None, flag: str, kind: str = "csv") -> None:
+    """Refuse, before any work is done, an output ``path`` that could not be written
+    (storage.output.check_output: missing or unwritable directory, a directory, not a
+    regular file, read-only, a figure format matplotlib cannot write)."""
+    if path is not None:
+        check_output(path, flag, kind)
 
 
 def write_atomically(path: str, text: str, flag: str) -> None:
-    """Write ``text`` to ``path`` so that no partial file is ever left behind."""
-    check_directory(path, flag)
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", newline="") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    """Write ``text`` to ``path``: all of it or, on any failure, nothing (the old file kept)."""
+    write_text(path, text, flag)
 
 
-def save_figure_atomically(fig: Figure, path: str) -> None:
-    """Save a figure to ``path`` [PNG] so that no partial file is left behind."""
+def save_figure_atomically(fig: Figure, path: str, flag: str = "--png") -> None:
+    """Save a figure to ``path`` (format from its extension), all of it or nothing."""
     from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=".plateimpact-", suffix=".png")
-    os.close(fd)
+    plotting.save(fig, path, flag)
+
+
+def write_stdout(text: str) -> None:
+    """Print ``text``; a standard output that cannot take it (a full device) is one line."""
     try:
-        plotting.save(fig, tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        raise OutputError(f"standard output: cannot write: {exc.strerror}") from None
 
 
 def csv_text(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from typing import Any
 
 import numpy as np
@@ -14,7 +13,14 @@ from ..crater import crater_section
 from ..registry import PluginRegistry
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
-from .common import UsageError, check_directory, csv_text, save_figure_atomically, write_atomically
+from .common import (
+    UsageError,
+    check_directory,
+    csv_text,
+    save_figure_atomically,
+    write_atomically,
+    write_stdout,
+)
 from .options import (
     add_body_options,
     add_model_options,
@@ -109,7 +115,7 @@ def run_command(args: argparse.Namespace) -> None:
 
 def crater_command(args: argparse.Namespace) -> None:
     check_directory(args.csv, "--csv")
-    check_directory(args.png, "--png")
+    check_directory(args.png, "--png", "figure")
     scene, simulation, label = _scene(args)
     result = simulation.run(scene, record_trajectory=True)
     assert result.trajectory is not None
@@ -185,7 +191,7 @@ def sweep_command(args: argparse.Namespace) -> None:
     )
     text = csv_text(SWEEP_COLUMNS, rows)
     if args.csv is None:
-        sys.stdout.write(text)
+        write_stdout(text)
         return
     write_atomically(args.csv, text, "--csv")
     counts = np.bincount(result.outcome, minlength=4)

@@ -3,50 +3,38 @@
 One file holds any number of studies; each study holds its scenes once and any number
 of runs. A run is appended by copying the archive to a temporary file, adding the run
 there and renaming the copy over the original (``os.replace``), so a crash at any point
-leaves the previous archive, with every finished run, untouched. A lock file next to
-the archive names the writing process; while it lives, opening the archive is refused.
+leaves the previous archive, with every finished run, untouched (storage.append). One
+writer at a time per real file, across threads and processes (storage.lock); readers
+never wait, since the file they open is always a whole one. A symlinked archive is
+followed: its target is written and locked, and keeps its mode, owner and group.
 """
 
 from __future__ import annotations
 
 import contextlib
+import datetime as dt
 import json
 import os
-import shutil
+import stat
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Protocol
 
 import attrs
 import h5py
 import numpy as np
 
-from ..batch import CORE_COLUMNS, SceneBatch
+from ..batch import SceneBatch
 from ..errors import ArchiveError, PlateImpactError, UnknownNameError
 from ..parameters import Parameter
 from ..ragged import Ragged
-from ..registry import default_registry
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from ..variant import Variant
-from .hdf5 import SEAL, digest, plain_attributes, seal, write_declared, write_ragged
-from .lock import check_not_busy, fsync_directory, locked
+from .append import FORMAT, FORMAT_VERSION, StudyDefinition, append, check_same_scenes
+from .hdf5 import SEAL, digest, plain_attributes
+from .lock import ArchiveBusyError, locked
 
-FORMAT, FORMAT_VERSION = "plateimpact-archive", 1
-
-
-class StudyDefinition(Protocol):
-    """What an archive stores of a study (:class:`plateimpact.Study` is one)."""
-
-    @property
-    def name(self) -> str: ...
-    @property
-    def scenes(self) -> SceneBatch: ...
-    @property
-    def variants(self) -> Sequence[Variant]: ...
-    @property
-    def plate_labels(self) -> Sequence[str]: ...
-    @property
-    def description(self) -> str: ...
+#: How long a writer waits for another one to finish with the archive [s].
+WAIT = 300.0
 
 
 @attrs.frozen(eq=False)
@@ -61,44 +49,42 @@ class ArchivedStudy:
     description: str
 
 
-def _scene_column(name: str, constants: dict[str, Parameter]) -> Parameter:
-    """The declaration of a scene column: a core column or a plate constant, as the run's
-    plug-ins (else any registered plug-in) declare it."""
-    declared = CORE_COLUMNS.get(name) or constants.get(name)
-    declared = declared or default_registry().plate_constants.get(name)
-    return declared or Parameter(name, f"plate constant {name} (no installed plug-in declares it)")
-
-
-def _trajectory_field(name: str, state_units: dict[str, str]) -> Parameter:
-    if name in TRAJECTORY_FIELDS:
-        return TRAJECTORY_FIELDS[name]
-    state = name.removeprefix("failure_")
-    return Parameter(
-        name, f"failure-model state {state!r} (NaN before failure)", state_units.get(state, "1")
-    )
-
-
 class Archive:
     """An HDF5 archive of studies and their runs at ``path``.
 
     Runs are named ``STUDY/RUN``; the bare ``RUN`` is enough when one study has it.
-    Every failure to open or read (missing directory, not HDF5, checksum mismatch, a
-    live writer) raises :class:`ArchiveError` with a one-line message.
+    Every failure to open, read or write (missing directory, not HDF5, another format
+    version, checksum mismatch, read-only, busy) raises :class:`ArchiveError` with a
+    one-line message. ``wait``: how long an append waits for another writer [s].
     """
 
-    def __init__(self, path: str | os.PathLike[str]) -> None:
+    def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
         self.path = Path(path)
-        self.lock_path = self.path.with_name(self.path.name + ".lock")
+        self.real = Path(os.path.realpath(path)) if os.fspath(path) else self.path
+        # (a name-less path, "" or "/", is refused by every method before the lock is used)
+        self.lock_path = self.real.parent / f"{self.real.name or 'root'}.lock"
+        self.wait = wait
 
     # -- writing ---------------------------------------------------------------------
 
     def check_writable(self) -> None:
-        """Refuse early what :meth:`append_run` would refuse after a long run."""
-        if not self.path.parent.is_dir():
-            raise ArchiveError(f"archive {self.path}: directory {self.path.parent} does not exist")
-        check_not_busy(self.path, self.lock_path)
-        if self.path.exists():
-            with self._open():
+        """Refuse early what :meth:`append_run` would refuse after a long run: a missing
+        or unwritable directory, a target that is not a regular file, a read-only
+        archive, one that is damaged or of another format version."""
+        directory = self.real.parent
+        if not os.fspath(self.path) or self.real.is_dir():
+            raise ArchiveError(f"archive {self.path!s}: give an archive file name")
+        if not directory.is_dir():
+            raise ArchiveError(f"archive {self.path}: directory {directory} does not exist")
+        if not os.access(directory, os.W_OK | os.X_OK):
+            raise ArchiveError(f"archive {self.path}: directory {directory} is not writable")
+        if self.real.exists():
+            mode = os.stat(self.real).st_mode
+            if not stat.S_ISREG(mode):
+                raise ArchiveError(f"archive {self.path} is not a regular file")
+            if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
+                raise ArchiveError(f"archive {self.path} is read-only; refusing to append to it")
+            with self._open():  # damaged, not an archive, another version: refused now
                 pass
 
     def append_run(
@@ -112,47 +98,35 @@ class Archive:
         """Add one finished run of ``study`` (atomically); returns its name ``STUDY/RUN``.
 
         ``constants`` are the declarations of the plate constants the run's plug-ins read
-        (units and descriptions of the scene datasets)."""
-        if not self.path.parent.is_dir():
-            raise ArchiveError(f"archive {self.path}: directory {self.path.parent} does not exist")
-        with locked(self.path, self.lock_path):
-            self._remove_stale_copies()
-            temporary = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
-            try:
-                if self.path.exists():
-                    with self._open():  # a damaged archive is reported, not extended
-                        pass
-                    shutil.copyfile(self.path, temporary)
-                with h5py.File(temporary, "a") as f:
-                    if FORMAT not in f.attrs.get("format", ""):
-                        f.attrs["format"] = FORMAT
-                        f.attrs["format_version"] = FORMAT_VERSION
-                        f.attrs["description"] = "plateimpact study archive; see docs/archive.md"
-                    group = self._study_group(f, study, constants or {})
-                    runs = group.require_group("runs")
-                    name, k = variant.name, 1
-                    while name in runs:
-                        k += 1
-                        name = f"{variant.name}.{k}"
-                    self._write_run(runs.create_group(name), result, attributes)
-                with open(temporary, "rb+") as handle:
-                    os.fsync(handle.fileno())
-                os.replace(temporary, self.path)
-                fsync_directory(self.path.parent)
-            finally:
-                temporary.unlink(missing_ok=True)
-        return f"{study.name}/{name}"
+        (units and descriptions of the scene datasets). If another writer keeps the
+        archive longer than ``wait``, the run is saved to a side archive beside it and
+        :class:`ArchiveBusyError` says where: a finished run is never lost."""
+        self.check_writable()
+        try:
+            with locked(self.path, self.real, self.lock_path, self.wait):
+                self.check_writable()  # as it is now that we hold it
+                run = append(self.real, study, variant, result, attributes, constants or {})
+        except ArchiveBusyError as exc:
+            side = self.real.with_name(
+                f"{self.real.stem}.{study.name}.{variant.name}."
+                f"{dt.datetime.now(dt.UTC):%Y%m%dT%H%M%S%f}{self.real.suffix}"
+            )
+            append(side, study, variant, result, attributes, constants or {})
+            raise ArchiveBusyError(
+                f"{exc}; run {study.name}/{variant.name} saved to {side}"
+            ) from None
+        return f"{study.name}/{run}"
 
     def finished_runs(self, study: StudyDefinition) -> dict[str, str]:
         """The runs of ``study`` already in the archive, by variant name: those whose
         recorded variant (plug-ins and settings) is one of the study's, on the same
         scenes. Empty when the archive or the study is not there yet."""
-        if not self.path.exists():
+        if not self.real.exists():
             return {}
         with self._open() as f:
             if study.name not in f:
                 return {}
-            self._check_same_scenes(f[study.name], study)
+            check_same_scenes(f[study.name], study, self.path)
             runs = f[study.name].get("runs", {})
             found: dict[str, str] = {}
             for name in sorted(runs, key=lambda r: _start(runs[r])):
@@ -161,77 +135,26 @@ class Archive:
                     found[recorded.name] = f"{study.name}/{name}"
             return found
 
-    @staticmethod
-    def _check_same_scenes(group: h5py.Group, study: StudyDefinition) -> None:
-        scenes, names = group["scenes"], set(study.scenes.columns)
-        same = set(scenes) - {"plate_label"} == names and all(
-            np.array_equal(scenes[k][()], study.scenes.columns[k]) for k in names
-        )
-        if not same:
-            raise ArchiveError(
-                f"the archive already holds a different study named {study.name!r}; "
-                "rename the study"
-            )
-
-    def _remove_stale_copies(self) -> None:
-        """Delete the temporary copies left by writers killed mid-append: we hold the
-        lock, so no other writer is using one."""
-        for copy in self.path.parent.glob(f".{self.path.name}.*.tmp"):
-            copy.unlink(missing_ok=True)
-
-    @staticmethod
-    def _study_group(
-        f: h5py.File, study: StudyDefinition, constants: dict[str, Parameter]
-    ) -> h5py.Group:
-        if study.name in f:
-            group = f[study.name]
-            Archive._check_same_scenes(group, study)
-            return group
-        group = f.create_group(study.name)
-        group.attrs["description"] = study.description
-        group.attrs["variants"] = json.dumps([json.loads(v.to_json()) for v in study.variants])
-        labels = sorted(set(study.plate_labels))
-        group.attrs["plate_labels"] = json.dumps(labels)
-        seal(group)
-        scenes = group.create_group("scenes")
-        scenes.attrs["count"] = study.scenes.size
-        for name, values in study.scenes.columns.items():
-            write_declared(scenes, _scene_column(name, constants), values)
-        index = np.array([labels.index(label) for label in study.plate_labels], dtype=np.int32)
-        label_field = Parameter("plate_label", "index into the study's plate_labels attribute")
-        write_declared(scenes, label_field, index)
-        return group
-
-    @staticmethod
-    def _write_run(group: h5py.Group, result: BatchResult, attributes: dict[str, object]) -> None:
-        for key, value in attributes.items():
-            group.attrs[key] = value
-        seal(group)
-        results = group.create_group("results")
-        for name, declared in RESULT_FIELDS.items():
-            write_declared(results, declared, result.columns[name])
-        if result.craters is not None:
-            write_ragged(
-                group.create_group("crater"), result.craters, "counts", "lateral", CRATER_FIELDS
-            )
-        if result.trajectory is not None:
-            state_units = json.loads(str(attributes.get("failure_state_units", "{}")))
-            fields = {k: _trajectory_field(k, state_units) for k in result.trajectory.values}
-            write_ragged(
-                group.create_group("trajectory"), result.trajectory, "count", "time", fields
-            )
-
     # -- reading ---------------------------------------------------------------------
 
     @contextlib.contextmanager
     def _open(self) -> Iterator[h5py.File]:
-        check_not_busy(self.path, self.lock_path)
-        if not self.path.exists():
+        if not os.fspath(self.path):
+            raise ArchiveError("give an archive file name")
+        if not self.real.exists():
             raise ArchiveError(f"archive {self.path} does not exist")
-        if not h5py.is_hdf5(self.path):
+        if not self.real.is_file():
+            raise ArchiveError(f"archive {self.path} is not a file")
+        if not os.access(self.real, os.R_OK):
+            raise ArchiveError(f"archive {self.path} cannot be read: permission denied")
+        try:
+            hdf5 = h5py.is_hdf5(self.real)
+        except OSError as exc:
+            raise ArchiveError(f"archive {self.path} cannot be read: {_first_line(exc)}") from None
+        if not hdf5:
             raise ArchiveError(f"{self.path} is not an HDF5 file")
         try:
-            f = h5py.File(self.path, "r")
+            f = h5py.File(self.real, "r")
         except OSError as exc:
             raise ArchiveError(
                 f"archive {self.path} cannot be opened: {_first_line(exc)}"
@@ -240,6 +163,12 @@ class Archive:
             try:
                 if f.attrs.get("format") != FORMAT:
                     raise ArchiveError(f"{self.path} is an HDF5 file but not a plateimpact archive")
+                version = f.attrs.get("format_version")
+                if version != FORMAT_VERSION:
+                    raise ArchiveError(
+                        f"archive {self.path} has format version {version}; this plateimpact "
+                        f"reads and writes version {FORMAT_VERSION}"
+                    )
                 yield f
             except PlateImpactError:
                 raise
@@ -343,7 +272,12 @@ class Archive:
         have no fletcher32 checksum of their own)."""
         attributes = plain_attributes(group)
         sealed = attributes.pop(SEAL, None)
-        if sealed is not None and sealed != digest(attributes):
+        if sealed is None:
+            raise ArchiveError(
+                f"archive {self.path}: the attributes of {group.name} are damaged "
+                "(their digest is missing)"
+            )
+        if sealed != digest(attributes):
             raise ArchiveError(
                 f"archive {self.path}: the attributes of {group.name} are damaged "
                 "(their digest does not match)"

@@ -1,66 +1,122 @@
-"""One writer per archive: a lock file naming the writing process, and atomic renames."""
+"""One writer per archive file at a time, across the threads of a process and across
+processes, keyed on the file's real path (a symlink and its target share one lock).
+
+Threads of one process queue on a :class:`threading.Lock`; processes on an advisory
+``flock`` of the lock file beside the archive (``ARCHIVE.lock``). The kernel releases a
+``flock`` when its process dies, so a killed writer never leaves a stale lock; the lock
+file itself stays (deleting it would let a waiting process lock a file that no longer
+exists while a third creates a new one). It names the last writer, for messages.
+A writer that finds the archive busy waits, up to a bound, and says so once.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import socket
+import threading
+import time
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
 from ..errors import ArchiveError
 
+#: How often a waiting writer looks again [s].
+POLL = 0.05
 
-def _pid_alive(pid: int) -> bool:
+_THREAD_LOCKS: dict[Path, threading.Lock] = {}
+_GUARD = threading.Lock()
+
+
+class ArchiveBusyError(ArchiveError):
+    """The archive stayed locked by another writer longer than the writer could wait."""
+
+
+class ArchiveWaitWarning(UserWarning):
+    """A writer is waiting for another one to finish with the archive."""
+
+
+def _thread_lock(real: Path) -> threading.Lock:
+    with _GUARD:
+        return _THREAD_LOCKS.setdefault(real, threading.Lock())
+
+
+def holder(lock_path: Path) -> str:
+    """Who last took the lock, as the lock file says ("process 123 on host")."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def check_not_busy(path: Path, lock_path: Path) -> None:
-    """Refuse an archive whose lock names a live process other than this one."""
-    try:
-        pid_text, host = lock_path.read_text().split()[:2]
-        pid = int(pid_text)
+        pid, host = lock_path.read_text().split()[:2]
+        return f"process {int(pid)} on {host}"
     except (OSError, ValueError):
-        return
-    if pid != os.getpid() and (host != socket.gethostname() or _pid_alive(pid)):
-        raise ArchiveError(
-            f"archive {path} is being written by process {pid} on {host}; "
-            f"wait for it to finish (or remove {lock_path} if that process is gone)"
-        )
+        return "another writer"
+
+
+def busy(lock_path: Path) -> bool:
+    """Whether a live writer holds the lock (never blocks)."""
+    try:
+        fd = os.open(lock_path, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)  # closing drops the shared lock taken to look
+    return False
 
 
 @contextlib.contextmanager
-def locked(path: Path, lock_path: Path) -> Iterator[None]:
-    """Hold the lock of ``path``; a lock left by a dead process is taken over."""
-    for _ in range(2):
-        try:
-            fd = os.open(lock_path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-        except FileExistsError:
-            check_not_busy(path, lock_path)  # raises if the writer lives; else it is stale
-            lock_path.unlink(missing_ok=True)
-            continue
-        with os.fdopen(fd, "w") as handle:
-            handle.write(f"{os.getpid()} {socket.gethostname()}\n")
-        break
-    else:
-        raise ArchiveError(f"archive {path}: cannot take the lock {lock_path}")
+def locked(path: Path, real: Path, lock_path: Path, wait: float) -> Iterator[None]:
+    """Hold the write lock of the archive whose real path is ``real`` (``path`` as the
+    user named it, for messages), waiting up to ``wait`` seconds for another writer;
+    :class:`ArchiveBusyError` if it is still busy then."""
+    deadline = time.monotonic() + wait
+    thread_lock = _thread_lock(real)
+    if not thread_lock.acquire(blocking=False):
+        _announce(path, "another thread of this process")
+        if not thread_lock.acquire(timeout=max(wait, 0.0)):
+            raise ArchiveBusyError(
+                f"archive {path} stayed busy with another thread of this process for {wait:g} s"
+            )
     try:
-        yield
-    finally:
-        lock_path.unlink(missing_ok=True)
-
-
-def fsync_directory(directory: Path) -> None:
-    """Make a rename in ``directory`` durable."""
-    with contextlib.suppress(OSError):
-        fd = os.open(directory, os.O_RDONLY)
         try:
-            os.fsync(fd)
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise ArchiveError(
+                f"archive {path}: cannot open its lock {lock_path}: {exc.strerror}"
+            ) from None
+        try:
+            announced = False
+            while True:
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    break
+                except BlockingIOError:
+                    if time.monotonic() >= deadline:
+                        raise ArchiveBusyError(
+                            f"archive {path} stayed busy ({holder(lock_path)} writing it) for "
+                            f"{wait:g} s"
+                        ) from None
+                    if not announced:
+                        _announce(path, holder(lock_path))
+                        announced = True
+                    time.sleep(POLL)
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+            yield
         finally:
-            os.close(fd)
+            os.close(fd)  # releases the flock
+    finally:
+        thread_lock.release()
+
+
+def _announce(path: Path, who: str) -> None:
+    warnings.warn(
+        f"archive {path} is being written by {who}; waiting for it",
+        ArchiveWaitWarning,
+        stacklevel=4,
+    )

@@ -23,6 +23,7 @@ from ..bodies import THICKNESS, Plate
 from ..errors import ParameterError, PlateFileError
 from ..parameters import Parameter
 from ..registry import PluginRegistry, default_registry
+from .output import write_text
 
 FORMAT = "plateimpact-plate-1"
 #: Keys that are not constants.
@@ -103,7 +104,7 @@ def load_plate_file(path: str | os.PathLike[str], registry: PluginRegistry | Non
     """The plate in a plate file (JSON; see the module's description)."""
     source = os.fspath(path)
     try:
-        with open(source, encoding="utf-8") as handle:
+        with open(source, encoding="utf-8-sig") as handle:  # a BOM is allowed
             data = json.load(handle)
     except OSError as exc:
         raise PlateFileError(f"{source}: cannot read: {exc.strerror}") from None
@@ -123,6 +124,5 @@ def plate_file_text(
 def save_plate_file(
     path: str | os.PathLike[str], plate: Plate, extra: Mapping[str, Any] | None = None
 ) -> None:
-    """Write ``plate`` to ``path`` as a plate file."""
-    with open(os.fspath(path), "w", encoding="utf-8") as handle:
-        handle.write(plate_file_text(plate, extra))
+    """Write ``plate`` to ``path`` as a plate file, atomically (storage.output)."""
+    write_text(path, plate_file_text(plate, extra), "plate file", kind="json")

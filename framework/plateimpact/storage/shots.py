@@ -116,7 +116,7 @@ class Shots:
         """Shots from a CSV file (see the module's description of the columns)."""
         source = os.fspath(path)
         try:
-            with open(source, encoding="utf-8", newline="") as handle:
+            with open(source, encoding="utf-8-sig", newline="") as handle:  # BOM allowed
                 text = handle.read()
         except (OSError, UnicodeDecodeError) as exc:
             reason = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"

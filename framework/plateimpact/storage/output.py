@@ -1,0 +1,183 @@
+"""Every output file plateimpact writes goes through here: checked before any work, then
+written atomically, so that nothing is ever half-written, replaced or loosened.
+
+:func:`check_output` refuses, with one line naming the flag, what could not end well:
+an empty name, a directory, a name too long, a missing or unwritable directory, a target
+that is not a regular file (a device, a fifo, a directory behind a link), a read-only
+target, a figure format matplotlib cannot write. :func:`write_output` then writes to a
+unique temporary file beside the real target (a symlink is followed: its target is
+written), flushes and fsyncs it, gives it the target's mode and group (or the umask's
+mode for a new file), and renames it over the target. A failure at any stage (a full
+disk, a lost mount) leaves the old file as it was and no temporary file behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import glob
+import os
+import stat
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import IO
+
+from ..errors import PlateImpactError
+
+#: What ``kind`` may end with; ``None``: any name.
+SUFFIXES: dict[str, tuple[str, ...] | None] = {
+    "csv": None,
+    "json": None,
+    "figure": (".png", ".svg", ".pdf", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp"),
+}
+
+
+class OutputError(PlateImpactError, OSError):
+    """An output file cannot be written where it was asked for; one line naming the flag."""
+
+
+def fault_point(stage: str) -> None:
+    """Called at each stage of a write ("open", "write", "fsync", "chmod", "replace"):
+    nothing, unless a test replaces it to fail or crash there deterministically."""
+
+
+def _name_max(directory: str) -> int:
+    try:
+        return os.pathconf(directory, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
+
+
+def umask() -> int:
+    """The process's umask, read without changing it (Linux), else by setting it back."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    current = os.umask(0o022)
+    os.umask(current)
+    return current
+
+
+def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> Path:
+    """The real file ``path`` names (links followed), after refusing what cannot be
+    written there. Call it before any computation."""
+    text = os.fspath(path)
+    if not text.strip():
+        raise OutputError(f"{flag}: give a file name, got {text!r}")
+    real = Path(os.path.realpath(text))
+    directory = str(real.parent)
+    if os.path.isdir(directory) and len(real.name.encode()) > _name_max(directory):
+        raise OutputError(f"{flag}: the file name is longer than {_name_max(directory)} bytes")
+    if text.endswith(os.sep) or real.is_dir():
+        raise OutputError(f"{flag}: {text!r} is a directory; give a file name")
+    if not os.path.isdir(directory):
+        raise OutputError(f"{flag}: directory {directory!r} does not exist")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise OutputError(f"{flag}: directory {directory!r} is not writable")
+    suffixes = SUFFIXES.get(kind)
+    if suffixes is not None and real.suffix.lower() not in suffixes:
+        raise OutputError(
+            f"{flag}: cannot tell the format of {text!r}; end the name with one of "
+            f"{', '.join(suffixes)}"
+        )
+    if real.exists() or real.is_symlink():
+        try:
+            mode = os.stat(real).st_mode
+        except OSError as exc:
+            raise OutputError(f"{flag}: {text!r} cannot be examined: {exc.strerror}") from None
+        if not stat.S_ISREG(mode):
+            raise OutputError(f"{flag}: {text!r} is not a regular file; refusing to replace it")
+        if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
+            raise OutputError(f"{flag}: {text!r} is read-only; refusing to replace it")
+    return real
+
+
+def write_output(
+    path: str | os.PathLike[str],
+    flag: str,
+    write: Callable[[IO[bytes]], object],
+    kind: str = "csv",
+) -> Path:
+    """Write the file ``path`` atomically with ``write(handle)`` (a binary handle); the
+    target's mode and group are kept. Returns the real path written."""
+    target = check_output(path, flag, kind)
+    remove_dead_temporaries(target)
+    temporary = ""
+    try:
+        fault_point("open")
+        prefix = f".{target.name}.{os.getpid()}."
+        fd, temporary = tempfile.mkstemp(dir=target.parent, prefix=prefix, suffix=".tmp")
+        with os.fdopen(fd, "wb") as handle:
+            fault_point("write")
+            write(handle)
+            handle.flush()
+            fault_point("fsync")
+            os.fsync(handle.fileno())
+        fault_point("chmod")
+        keep_mode(temporary, target)
+        fault_point("replace")
+        os.replace(temporary, target)
+        temporary = ""
+        fsync_directory(target.parent)
+    except OSError as exc:
+        reason = exc.strerror or os.strerror(exc.errno or errno.EIO)
+        raise OutputError(f"{flag}: cannot write {os.fspath(path)!r}: {reason}") from None
+    finally:
+        if temporary:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)
+    return target
+
+
+def write_text(path: str | os.PathLike[str], text: str, flag: str, kind: str = "csv") -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    return write_output(path, flag, lambda handle: handle.write(text.encode()), kind)
+
+
+def pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (on this host)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def remove_dead_temporaries(target: Path) -> None:
+    """Delete the temporary files of writers of ``target`` that were killed mid-write
+    (``.NAME.PID.XXXX.tmp`` whose process is gone)."""
+    for temporary in target.parent.glob(f".{glob.escape(target.name)}.*.tmp"):
+        pid = temporary.name[len(target.name) + 2 :].split(".")[0]
+        if pid.isdigit() and not pid_alive(int(pid)):
+            temporary.unlink(missing_ok=True)
+
+
+def keep_mode(temporary: str, target: Path) -> None:
+    """Give ``temporary`` the mode, owner and group of ``target`` if it exists (as far as
+    this process may), else the mode a new file gets under the umask."""
+    try:
+        status = os.stat(target)
+    except FileNotFoundError:
+        os.chmod(temporary, 0o666 & ~umask())
+        return
+    os.chmod(temporary, stat.S_IMODE(status.st_mode))
+    try:
+        os.chown(temporary, status.st_uid, status.st_gid)
+    except PermissionError:  # not ours to give away: keep the group if we may
+        with contextlib.suppress(PermissionError):
+            os.chown(temporary, -1, status.st_gid)
+
+
+def fsync_directory(directory: Path) -> None:
+    """Make a rename in ``directory`` durable."""
+    with contextlib.suppress(OSError):
+        fd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)

@@ -1,0 +1,191 @@
+"""Archive writers: never a lost run, never a replaced file, never a second writer; failures
+injected deterministically at each stage of an append (storage.append.fault_point)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import stat
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from test_output_files import assert_one_line, mounted, run_cli
+
+import plateimpact as pi
+from plateimpact.storage import append as appending
+
+STAGES = ("copy", "write", "flush", "fsync", "replace")
+
+
+def tiny_study(name: str = "w") -> pi.Study:
+    return pi.Study.grid(name, ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
+
+
+@pytest.fixture(scope="module")
+def tiny_result() -> pi.BatchResult:
+    return tiny_study().run()["v"]
+
+
+def make_archive(path: Path) -> bytes:
+    tiny_study().run(archive=path)
+    return path.read_bytes()
+
+
+def debris(directory: Path) -> list[str]:
+    return sorted(p.name for p in directory.iterdir() if p.name.endswith(".tmp"))
+
+
+@pytest.mark.parametrize("stage", STAGES)
+def test_a_failed_append_leaves_the_archive_as_it_was(tmp_path, stage, monkeypatch, tiny_result):
+    path = tmp_path / "a.h5"
+    before = make_archive(path)
+
+    def fail(where: str) -> None:
+        if where == stage:
+            raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(appending, "fault_point", fail)
+    study = tiny_study()
+    with pytest.raises(OSError, match="No space left"):
+        pi.Archive(path).append_run(study, pi.Variant("x"), tiny_result, {"variant": "{}"})
+    assert path.read_bytes() == before and debris(tmp_path) == []
+    monkeypatch.undo()
+    pi.Archive(path).append_run(study, pi.Variant("x"), tiny_result, {"note": "next"})
+    assert set(pi.Archive(path).runs()) == {"w/v", "w/x"}  # and the lock was let go
+
+
+KILLED_APPENDER = """
+import os, signal, sys
+import numpy as np
+import plateimpact as pi
+from plateimpact.storage import append
+study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
+result = study.run()["v"]
+def die(stage):
+    if stage == sys.argv[2]:
+        os.kill(os.getpid(), signal.SIGKILL)
+append.fault_point = die
+pi.Archive(sys.argv[1]).append_run(study, pi.Variant("killed"), result, {"note": "x"})
+"""
+
+
+@pytest.mark.parametrize("stage", STAGES)
+def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stage, tiny_result):
+    path = tmp_path / "a.h5"
+    before = make_archive(path)
+    done = subprocess.run([sys.executable, "-c", KILLED_APPENDER, str(path), stage])
+    assert done.returncode == -signal.SIGKILL
+    assert path.read_bytes() == before and pi.Archive(path).runs() == ["w/v"]
+    pi.Archive(path).append_run(tiny_study(), pi.Variant("next"), tiny_result, {"note": "x"})
+    assert set(pi.Archive(path).runs()) == {"w/v", "w/next"} and debris(tmp_path) == []
+
+
+RACER = """
+import sys
+import numpy as np
+import plateimpact as pi
+study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
+result = study.run()["v"]
+for k in range(5):
+    pi.Archive(sys.argv[1]).append_run(study, pi.Variant(f"p{sys.argv[2]}r{k}"), result, {"n": k})
+"""
+
+
+@pytest.mark.filterwarnings("ignore::plateimpact.storage.lock.ArchiveWaitWarning")
+def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
+    path = tmp_path / "a.h5"
+    link = tmp_path / "link.h5"
+    make_archive(path)
+    link.symlink_to(path)  # half the threads write through a link: one lock, one file
+    study = tiny_study()
+    processes = [
+        subprocess.Popen([sys.executable, "-c", RACER, str(path), str(p)]) for p in range(4)
+    ]
+    errors: list[BaseException] = []
+
+    def appender(t: int) -> None:
+        try:
+            for k in range(5):
+                target = link if t % 2 else path
+                pi.Archive(target).append_run(study, pi.Variant(f"t{t}r{k}"), tiny_result, {"n": k})
+        except BaseException as exc:  # noqa: BLE001 (reported below)
+            errors.append(exc)
+
+    threads = [threading.Thread(target=appender, args=(t,)) for t in range(8)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert [p.wait() for p in processes] == [0, 0, 0, 0] and errors == []
+    runs = pi.Archive(path).runs()
+    expected = {f"w/t{t}r{k}" for t in range(8) for k in range(5)}
+    expected |= {f"w/p{p}r{k}" for p in range(4) for k in range(5)}
+    assert set(runs) == expected | {"w/v"} and len(runs) == 61
+    for run in runs:
+        np.testing.assert_array_equal(
+            pi.Archive(path).results(run).exit_speed, tiny_result.exit_speed
+        )
+    assert link.is_symlink() and debris(tmp_path) == []
+
+
+def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(tmp_path, tiny_result):
+    path = tmp_path / "a.h5"
+    make_archive(path)
+    path.chmod(0o640)
+    os.chown(path, -1, os.getgid())
+    tiny_study().run(archive=path)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o640 and path.stat().st_gid == os.getgid()
+    path.chmod(0o444)
+    before = path.read_bytes()
+    with pytest.raises(pi.ArchiveError, match="read-only; refusing to append"):
+        tiny_study().run(archive=path)
+    assert path.read_bytes() == before
+
+
+def test_an_archive_of_another_format_version_is_refused(tmp_path):
+    path = tmp_path / "a.h5"
+    make_archive(path)
+    with h5py.File(path, "a") as f:
+        f.attrs["format_version"] = 99
+    before = path.read_bytes()
+    for argv in (["show", str(path)], ["compare", str(path), "v", "v"]):
+        code, _, err = run_cli(argv)
+        assert_one_line(code, err, "format version 99", "version 1")
+    with pytest.raises(pi.ArchiveError, match="format version 99"):
+        tiny_study().run(archive=path)
+    assert path.read_bytes() == before
+
+
+def test_a_group_without_its_seal_is_damaged(tmp_path):
+    path = tmp_path / "a.h5"
+    make_archive(path)
+    with h5py.File(path, "a") as f:
+        del f["w/runs/v"].attrs["attributes_sha256"]
+    code, _, err = run_cli(["show", str(path)])
+    assert_one_line(code, err, "digest is missing")
+
+
+@pytest.mark.parametrize("name", ["a\0b", "tab\there", "line\nbreak", "a/b", " padded", ""])
+def test_names_that_would_not_survive_hdf5_are_refused(name):
+    with pytest.raises(pi.ParameterError, match="printable name"):
+        tiny_study(name)
+    with pytest.raises(pi.ParameterError, match="printable name"):
+        pi.Variant(name)
+
+
+def test_an_archive_in_a_read_only_place_is_one_line(tmp_path):
+    with mounted(tmp_path, "size=64k,ro") as disk:
+        with pytest.raises(pi.ArchiveError, match="not writable|Read-only"):
+            tiny_study().run(archive=disk / "a.h5")
+
+
+@pytest.mark.parametrize("argument", ["", ".", "/"])
+def test_show_of_what_is_not_an_archive_file_is_one_line(argument, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli(["show", argument])
+    assert_one_line(code, err)
