@@ -189,3 +189,15 @@ def test_show_of_what_is_not_an_archive_file_is_one_line(argument, tmp_path, mon
     monkeypatch.chdir(tmp_path)
     code, _, err = run_cli(["show", argument])
     assert_one_line(code, err)
+
+
+def test_a_full_disk_during_an_append_keeps_the_archive_and_is_one_line(tmp_path):
+    with mounted(tmp_path, "size=256k") as disk:
+        path = disk / "a.h5"
+        before = make_archive(path)
+        (disk / "filler").write_bytes(b"\0" * (256 * 1024 - len(before) - 8192))
+        big = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]),
+                            pi.Variant("big"))  # fmt: skip
+        with pytest.raises(pi.ArchiveError, match="No space left on device.*unchanged"):
+            big.run(archive=path, record_trajectory=True)
+        assert path.read_bytes() == before and debris(disk) == []

@@ -208,7 +208,7 @@ class TestHingeFinger:
 def test_bad_pstar_tables_are_refused_by_name(rows, message):
     with pytest.raises(pi.ParameterError) as info:
         VariablePstar(table=rows)
-    assert info.value.parameter == "pstar_table" and message in str(info.value)
+    assert info.value.parameter == "table" and message in str(info.value)
     assert "\n" not in str(info.value)
 
 

@@ -25,7 +25,7 @@ TABLE_COLUMNS = (
 
 
 def _fail(message: str) -> ParameterError:
-    return ParameterError("pstar_table", f"pstar table: {message}")
+    return ParameterError("table", f"pstar table: {message}")
 
 
 @final
@@ -170,7 +170,7 @@ def _to_table(value: object) -> PstarTable:
     if isinstance(value, Sequence):
         return PstarTable.from_rows(value)
     raise ParameterError(
-        "pstar_table", f"pstar table must be a PstarTable, rows or a CSV path, got {value!r}"
+        "table", f"pstar table must be a PstarTable, rows or a CSV path, got {value!r}"
     )
 
 

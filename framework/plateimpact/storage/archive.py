@@ -115,6 +115,13 @@ class Archive:
             raise ArchiveBusyError(
                 f"{exc}; run {study.name}/{variant.name} saved to {side}"
             ) from None
+        except ArchiveError:
+            raise
+        except OSError as exc:  # a full disk, a lost mount: the archive is as it was
+            raise ArchiveError(
+                f"archive {self.path}: cannot add run {study.name}/{variant.name}: "
+                f"{exc.strerror or exc} (the archive is unchanged)"
+            ) from None
         return f"{study.name}/{run}"
 
     def finished_runs(self, study: StudyDefinition) -> dict[str, str]:
