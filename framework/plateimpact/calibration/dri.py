@@ -11,6 +11,9 @@ from ..errors import CalibrationError
 
 #: Fewest perforating shots a DRI fit takes: two fix R and V0, a third leaves a residual.
 MIN_PERFORATIONS = 3
+#: Smallest spread of Vs² among them, relative to the largest, that determines a slope
+#: (below it the normal equations are singular to rounding).
+SPEED_SPREAD = 1e-6
 
 
 @attrs.frozen(eq=False)
@@ -68,6 +71,13 @@ def fit_dri(impact_speed: np.ndarray, residual_speed: np.ndarray) -> DriFit:
             f"the DRI fit needs at least {MIN_PERFORATIONS} perforating shots, got {n}"
         )
     vs, vr = vs[used], vr[used]
+    # Eq 41 fits a line through (Vs², Vr²): shots at (nearly) one speed fix no slope.
+    spread = float(np.ptp(vs**2)) / float(np.max(vs**2))
+    if not spread > SPEED_SPREAD:
+        raise CalibrationError(
+            f"the DRI fit needs perforating shots at different impact speeds; these span "
+            f"{float(np.ptp(vs)):.3g} m/s around {float(np.mean(vs)):.4g} m/s"
+        )
     # Eq 41: Y = M X + B, X = Vs², Y = Vr²; X is scaled so the normal matrix is O(1).
     scale = float(np.mean(vs**2))
     design = np.column_stack([vs**2 / scale, np.ones(n)])
