@@ -25,7 +25,7 @@ LAYERS = {
     },
     "running": {
         "dense", "dynamics", "integrator", "control", "events", "recorder", "driver",
-        "hookspecs", "registry", "simulation", "variant", "progress",
+        "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
     },
     "storage": {"storage"},
     "analysis": {"study", "calibration", "plotting"},

@@ -43,6 +43,7 @@ _EXPORTS: dict[str, str] = {
     "PluginRegistry": "registry",
     "default_registry": "registry",
     "load_registry": "registry",
+    "BrokenPackage": "discovery",
     # the model and its events
     "ImpactModel": "model",
     "KINEMATIC_STATE": "model",
@@ -99,6 +100,7 @@ _EXPORTS: dict[str, str] = {
     "CalibrationError": "errors",
     "ConvergenceError": "errors",
     "PluginError": "errors",
+    "PluginLoadWarning": "errors",
 }
 #: Submodules users reach as attributes (``pi.units.mm``).
 _SUBMODULES = ("batch", "calibration", "geometry", "presets", "units")
@@ -143,6 +145,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         newton_fit,
     )
     from .dense import DenseOutput, PolynomialDenseOutput, hermite
+    from .discovery import BrokenPackage
     from .dynamics import Dynamics
     from .errors import (
         ArchiveError,
@@ -153,6 +156,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         PlateFileError,
         PlateImpactError,
         PluginError,
+        PluginLoadWarning,
         ShotDataError,
         UnknownNameError,
     )

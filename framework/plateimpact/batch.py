@@ -6,6 +6,7 @@ see a :class:`SceneBatch`, whose columns are arrays with one entry per scene.
 
 from __future__ import annotations
 
+import reprlib
 from collections.abc import Iterable, Mapping
 
 import numpy as np
@@ -23,6 +24,25 @@ CORE_COLUMNS: dict[str, Parameter] = {
 }
 
 
+def _floats(name: str, values: object) -> np.ndarray:
+    """``values`` as a 1-D float array; anything else is a ParameterError naming them."""
+    try:
+        return np.ascontiguousarray(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(name, f"{name} must be numbers, got {reprlib.repr(values)}") from None
+
+
+def _batches(batches: Iterable[SceneBatch]) -> list[SceneBatch]:
+    try:
+        found = list(batches)
+    except TypeError:
+        found = [batches]  # type: ignore[list-item]  # reported below
+    for batch in found:
+        if not isinstance(batch, SceneBatch):
+            raise ParameterError("batches", f"expected SceneBatch objects, got {batch!r:.80}")
+    return found
+
+
 class SceneBatch:
     """Per-scene parameters as 1-D float arrays of equal length.
 
@@ -38,7 +58,11 @@ class SceneBatch:
     size: int
 
     def __init__(self, columns: Mapping[str, object], *, validate: bool = True) -> None:
-        arrays = {k: np.ascontiguousarray(c, dtype=float).reshape(-1) for k, c in columns.items()}
+        if not isinstance(columns, Mapping):
+            raise ParameterError(
+                "columns", f"a batch takes a mapping of column names to arrays, got {columns!r:.80}"
+            )
+        arrays = {k: _floats(k, c) for k, c in columns.items()}
         sizes = {a.size for a in arrays.values()}
         if len(sizes) > 1:
             raise ParameterError("columns", f"batch columns differ in length: {sorted(sizes)}")
@@ -67,7 +91,16 @@ class SceneBatch:
     def from_scenes(cls, scenes: Iterable[Scene]) -> SceneBatch:
         """Columns from validated :class:`Scene` objects, whose plates must have the same
         constants."""
-        scenes = list(scenes)
+        try:
+            scenes = list(scenes)
+        except TypeError:
+            scenes = [scenes]  # type: ignore[list-item]  # reported below
+        for i, scene in enumerate(scenes):
+            if not isinstance(scene, Scene):
+                raise ParameterError(
+                    "scenes",
+                    f"expected a SceneBatch or Scene objects, got {scene!r:.80} (item {i})",
+                )
         names = [tuple(k for k, _ in s.plate.constants) for s in scenes]
         for i, found in enumerate(names):
             if found != names[0]:
@@ -100,8 +133,13 @@ class SceneBatch:
         Parameters: speeds [m/s]; obliquities [rad]. Built as arrays, without a Scene
         object per point, so that a 10,000-scene sweep costs no Python loop.
         """
-        speeds = np.asarray(speeds, dtype=float).reshape(-1)
-        obliquities = np.asarray(obliquities, dtype=float).reshape(-1)
+        if not (isinstance(sphere, Sphere) and isinstance(plate, Plate)):
+            raise ParameterError(
+                "sphere" if not isinstance(sphere, Sphere) else "plate",
+                f"grid takes a Sphere and a Plate, got {sphere!r:.60} and {plate!r:.60}",
+            )
+        speeds = _floats("impact_speed", speeds)
+        obliquities = _floats("impact_obliquity", obliquities)
         IMPACT_SPEED.check(speeds)
         IMPACT_OBLIQUITY.check(obliquities)
         obl, spd = np.meshgrid(obliquities, speeds, indexing="ij")
@@ -119,7 +157,7 @@ class SceneBatch:
     @classmethod
     def concat(cls, batches: Iterable[SceneBatch]) -> SceneBatch:
         """One batch holding the scenes of ``batches`` in order (same columns required)."""
-        batches = list(batches)
+        batches = _batches(batches)
         names = list(batches[0]._columns) if batches else list(CORE_COLUMNS)
         for batch in batches:
             if set(batch._columns) != set(names):
@@ -167,7 +205,13 @@ class SceneBatch:
         """A batch with more (or replaced) columns, each broadcast to the batch size."""
         merged = dict(self._columns)
         for name, values in extra.items():
-            merged[name] = np.broadcast_to(np.asarray(values, dtype=float), (self.size,))
+            array = _floats(name, values)
+            try:
+                merged[name] = np.broadcast_to(array, (self.size,))
+            except ValueError:  # not one value and not one per scene
+                raise ParameterError(
+                    name, f"column {name!r} needs 1 or {self.size} values, got {array.size}"
+                ) from None
         return SceneBatch(merged, validate=False)
 
     def take(self, index: np.ndarray) -> SceneBatch:

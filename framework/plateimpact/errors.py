@@ -61,3 +61,9 @@ class PluginError(PlateImpactError):
     """A plug-in is malformed or two plug-ins conflict: an undeclared or missing prepared
     column, two declarations of one plate constant that disagree, a class that cannot be
     registered. The message names the plug-ins."""
+
+
+class PluginLoadWarning(UserWarning):
+    """An installed plug-in package failed to load and was skipped; the message names
+    the distribution, the entry point and the error. Filter it like any warning
+    (``warnings.filterwarnings("ignore", category=PluginLoadWarning)``)."""

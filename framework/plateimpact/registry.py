@@ -1,16 +1,39 @@
-"""Plug-in discovery: pluggy registers classes by name; lookups are plain dict reads."""
+"""Plug-in discovery: pluggy registers classes by name; lookups are plain dict reads.
+
+Installed packages are loaded one at a time: a package that fails to load (an import
+error, a misspelled or failing hook, a class the registry refuses) is skipped, with one
+warning naming it, and recorded in :attr:`PluginRegistry.broken`; the others, built-ins
+included, keep working. Plug-ins handed to :func:`load_registry` directly are the
+caller's own code and fail loudly instead.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import functools
-from collections.abc import Iterable
+import warnings
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 import pluggy
 
 from . import hookspecs
 from .batch import CORE_COLUMNS
-from .errors import ParameterError, PluginError, UnknownNameError
+from .discovery import (
+    BrokenPackage,
+    distribution_label,
+    distribution_name,
+    entry_point_label,
+    first_line,
+    installed_entry_points,
+)
+from .errors import (
+    ParameterError,
+    PlateImpactError,
+    PluginError,
+    PluginLoadWarning,
+    UnknownNameError,
+)
 from .failure import FailureModel
 from .integrator import Integrator
 from .parameters import Parameter
@@ -25,19 +48,34 @@ KINDS: dict[str, type[Plugin]] = {
 }
 
 
+def _flag_list(kind: str, cls: type[Plugin]) -> list[tuple[str, str]]:
+    """The command-line flags a plug-in declares, each with what it sets."""
+    found = [(p.flag, f"{kind} setting {s}") for s, p in cls.setting_declarations().items()]
+    found += [(p.flag, f"plate constant {p.name}") for p in cls.plate_constants]
+    return [(flag, meaning) for flag, meaning in found if flag]
+
+
 class PluginRegistry:
     """Name → class tables, one per kind of plug-in, and the plate constants they declare.
 
     Registering checks a class's declarations: a plate constant may be declared by several
     plug-ins only with equal declarations, so that a plate's ``a`` means one thing
     whatever model reads it; a plug-in's settings, plate constants and prepared columns
-    may not share a name.
+    may not share a name; a command-line flag sets one thing. :attr:`broken` lists the
+    installed packages that failed to load.
     """
 
     def __init__(self) -> None:
         self._classes: dict[str, dict[str, type[Plugin]]] = {kind: {} for kind in KINDS}
         self._origin: dict[tuple[str, str], str] = {}
         self._constants: dict[str, tuple[Parameter, list[str]]] = {}
+        self._broken: tuple[BrokenPackage, ...] = ()
+        self._attempted: list[tuple[str, str]] | None = None
+
+    @property
+    def broken(self) -> tuple[BrokenPackage, ...]:
+        """The installed plug-in packages that failed to load and were skipped."""
+        return self._broken
 
     def add(self, cls: type) -> None:
         """Register a concrete ResistanceLaw, FailureModel or Integrator subclass."""
@@ -48,6 +86,8 @@ class PluginRegistry:
         if not isinstance(name, str) or not name:
             raise PluginError(f"{cls.__qualname__} ({cls.__module__}) has no 'name'")
         kind = kinds[0]
+        if self._attempted is not None:
+            self._attempted.append((kind, name))
         plugin: type[Plugin] = cls
         label = f"{kind} {name!r} ({cls.__module__})"
         if name in self._classes[kind] and self._classes[kind][name] is not cls:
@@ -55,14 +95,34 @@ class PluginRegistry:
                 f"{kind} {name!r} is registered twice: by {self._origin[kind, name]} "
                 f"and by {cls.__module__}"
             )
-        self._check_declarations(plugin, label)
+        self._check_declarations(kind, plugin, label)
         for declared in plugin.plate_constants:
             entry = self._constants.setdefault(declared.name, (declared, []))
             entry[1].append(f"{kind} {name}")
         self._classes[kind][name] = plugin
         self._origin[kind, name] = plugin.__module__
 
-    def _check_declarations(self, cls: type[Plugin], label: str) -> None:
+    @contextlib.contextmanager
+    def _all_or_nothing(self, attempted: list[tuple[str, str]]) -> Iterator[None]:
+        """Classes added inside the block stay registered only if the block completes, so
+        that a package whose hook fails half-way leaves none of its classes behind (a
+        package's classes may rely on each other); ``attempted`` collects the
+        ``(kind, name)`` of every class the block tried to add."""
+        saved = (
+            {kind: dict(table) for kind, table in self._classes.items()},
+            dict(self._origin),
+            {name: (declared, list(users)) for name, (declared, users) in self._constants.items()},
+        )
+        self._attempted = attempted
+        try:
+            yield
+        except BaseException:
+            self._classes, self._origin, self._constants = saved
+            raise
+        finally:
+            self._attempted = None
+
+    def _check_declarations(self, kind: str, cls: type[Plugin], label: str) -> None:
         constants = list(cls.plate_constants)
         if not all(isinstance(p, Parameter) for p in constants):
             raise PluginError(f"{label}: plate_constants must be Parameter declarations")
@@ -83,6 +143,24 @@ class PluginRegistry:
                     f"{label} declares plate constant {declared.name!r} unlike "
                     f"{', '.join(known[1])}: declare the same Parameter object"
                 )
+        self._check_flags(kind, cls, label)
+
+    def _check_flags(self, kind: str, cls: type[Plugin], label: str) -> None:
+        """A command-line flag sets one thing: a core quantity's flag is the core's, and
+        two plug-ins share a flag only for the same setting or plate constant (else the
+        command line could not be built, for any command)."""
+        taken = {p.flag: f"the core's {p.name}" for p in CORE_COLUMNS.values() if p.flag}
+        for other_kind, table in self._classes.items():
+            for other in table.values():
+                if other is not cls:
+                    taken.update(_flag_list(other_kind, other))
+        own: dict[str, str] = {}
+        for flag, meaning in _flag_list(kind, cls):
+            known = own.setdefault(flag, taken.get(flag, meaning))
+            if known != meaning:
+                raise PluginError(
+                    f"{label} declares the flag {flag} for {meaning}, but {flag} sets {known}"
+                )
 
     @property
     def plate_constants(self) -> dict[str, Parameter]:
@@ -93,17 +171,35 @@ class PluginRegistry:
         """The plug-ins (``"failure plugging"``) that declare a plate constant."""
         return list(self._constants.get(constant, (None, []))[1])
 
+    def _table(self, kind: str) -> dict[str, type[Plugin]]:
+        if not (isinstance(kind, str) and kind in KINDS):
+            choices = ", ".join(KINDS)
+            raise UnknownNameError(f"unknown plug-in kind {kind!r}; choose from: {choices}")
+        return self._classes[kind]
+
     def names(self, kind: str) -> list[str]:
         """Registered names of one kind, sorted."""
-        return sorted(self._classes[kind])
+        return sorted(self._table(kind))
 
     def get(self, kind: str, name: str) -> type[Plugin]:
-        """The class registered as ``name``; UnknownNameError lists the choices."""
-        try:
-            return self._classes[kind][name]
-        except KeyError:
-            choices = ", ".join(self.names(kind)) or "none registered"
-            raise UnknownNameError(f"unknown {kind} {name!r}; choose from: {choices}") from None
+        """The class registered as ``name``; UnknownNameError lists the choices, and says
+        so when the name belongs to, or might belong to, a package that failed to load."""
+        table = self._table(kind)
+        if isinstance(name, str) and name in table:
+            return table[name]
+        for package in self._broken:
+            if (kind, name) in package.provides:
+                raise UnknownNameError(
+                    f"{kind} {name!r} is in plug-in package {package.distribution}, which "
+                    f"failed to load: {package.error}"
+                )
+        choices = ", ".join(self.names(kind)) or "none registered"
+        skipped = ""
+        if self._broken:
+            labels = ", ".join(package.distribution for package in self._broken)
+            count = len(self._broken)
+            skipped = f" ({count} plug-in package{'s' * (count > 1)} failed to load: {labels})"
+        raise UnknownNameError(f"unknown {kind} {name!r}; choose from: {choices}{skipped}")
 
     def create(self, kind: str, name: str, **settings: Any) -> Any:
         """An instance of the ``name`` plug-in with ``settings`` [SI].
@@ -120,8 +216,22 @@ class PluginRegistry:
             )
         try:
             return cls(**settings)
-        except TypeError as exc:
-            raise ParameterError(name, f"{kind} {name!r}: {exc}") from None
+        except PlateImpactError:
+            raise
+        except (TypeError, ValueError, OverflowError) as exc:  # a setting of the wrong kind
+            raise ParameterError(name, f"{kind} {name!r}: {str(exc).strip()}") from None
+
+
+class HookValidationError(PluginError, pluggy.PluginValidationError):
+    """A hook implementation that pluggy refuses (a misspelled hook name, an argument the
+    hook does not have). Also a ``pluggy.PluginValidationError``, which is what
+    :func:`load_registry` raised for it before."""
+
+
+def _refused(exc: pluggy.PluginValidationError) -> HookValidationError:
+    """pluggy's refusal, as one line (it spans three for an argument the hook lacks)."""
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    return HookValidationError(exc.plugin, "; ".join(lines))
 
 
 def load_registry(*, entry_points: bool = True, plugins: Iterable[object] = ()) -> PluginRegistry:
@@ -131,21 +241,114 @@ def load_registry(*, entry_points: bool = True, plugins: Iterable[object] = ()) 
     ----------
     entry_points : bool
         Load the installed packages of the ``plateimpact`` entry-point group (the
-        built-ins and any third-party package). False gives a registry of ``plugins``
-        only, which keeps a test independent of what else is installed.
+        built-ins and any third-party package). A package that fails to load, whose hook
+        is misspelled or raises, or one of whose classes the registry refuses, is
+        skipped with a :class:`~plateimpact.errors.PluginLoadWarning` and listed in
+        :attr:`PluginRegistry.broken`; none of its classes is registered. False gives a
+        registry of ``plugins`` only, which keeps a test independent of what else is
+        installed.
     plugins : iterable of modules or objects
-        Extra hook implementations to register directly.
+        Extra hook implementations to register directly. Any problem with one of them
+        raises :class:`~plateimpact.errors.PluginError`.
     """
     manager = pluggy.PluginManager(hookspecs.PROJECT)
     manager.add_hookspecs(hookspecs)
+    # pluggy's name of each installed package -> (distribution, entry point), for reports
+    installed: dict[str, tuple[str, str]] = {}
+    builtins: set[str] = set()  # those of plateimpact's own distribution
+    broken: list[BrokenPackage] = []
     if entry_points:
-        manager.load_setuptools_entrypoints(hookspecs.PROJECT)
-    for plugin in plugins:
-        manager.register(plugin)
-    manager.check_pending()
+        for entry in installed_entry_points(hookspecs.PROJECT):
+            if isinstance(entry, BrokenPackage):
+                broken.append(entry)
+                continue
+            where = (distribution_label(entry.dist), entry_point_label(entry))
+            try:
+                plugin = entry.load()
+                if manager.is_registered(plugin):  # one module behind two entry points
+                    continue
+                name = manager.register(plugin, name=entry.value)
+            except Exception as exc:
+                if isinstance(exc, pluggy.PluginValidationError):
+                    exc = _refused(exc)
+                broken.append(BrokenPackage(*where, first_line(exc)))
+                continue
+            if name is not None:
+                installed[name] = where
+                if distribution_name(entry.dist) == hookspecs.PROJECT:
+                    builtins.add(name)
+    _register_given(manager, plugins)
+    while True:  # a misspelled hook is an error, not a silent no-op: the package is broken
+        try:
+            manager.check_pending()
+            break
+        except pluggy.PluginValidationError as exc:
+            name = manager.get_name(exc.plugin)
+            if name not in installed:
+                raise _refused(exc) from None
+            manager.unregister(exc.plugin)
+            broken.append(BrokenPackage(*installed.pop(name), first_line(_refused(exc))))
     registry = PluginRegistry()
-    manager.hook.plateimpact_register(registry=registry)
+    broken += _run_hooks(manager, registry, installed, builtins)
+    registry._broken = tuple(broken)
+    for package in broken:
+        warnings.warn(
+            f"plug-in package {package.distribution} failed to load and is skipped "
+            f"(entry point {package.entry_point}): {package.error}",
+            PluginLoadWarning,
+            stacklevel=2,
+        )
     return registry
+
+
+def _register_given(manager: pluggy.PluginManager, plugins: Iterable[object]) -> None:
+    """Register the plug-ins handed to load_registry; any problem raises PluginError."""
+    try:
+        given = list(plugins)
+    except TypeError:
+        raise PluginError(
+            f"plugins must be an iterable of modules or objects, got {plugins!r}"
+        ) from None
+    for plugin in given:
+        try:
+            manager.register(plugin)
+        except pluggy.PluginValidationError as exc:
+            raise _refused(exc) from None
+        except ValueError as exc:  # registered twice, or a name taken
+            raise PluginError(f"plug-in {plugin!r} cannot be registered: {exc}") from None
+
+
+def _run_hooks(
+    manager: pluggy.PluginManager,
+    registry: PluginRegistry,
+    installed: dict[str, tuple[str, str]],
+    builtins: set[str],
+) -> list[BrokenPackage]:
+    """Each package's hook, one package at a time and all or nothing; the installed
+    packages that failed (the others raise PluginError)."""
+    arguments = {"registry": registry}
+    broken = []
+    # The built-ins first, so that a package clashing with them (a name, a flag, a plate
+    # constant declared otherwise) is the one skipped, never the built-ins; then pluggy's
+    # own calling order (the last registered first). One implementation at a time, with
+    # its arguments as pluggy passes them (a subset of the hook's, by name).
+    impls = reversed(manager.hook.plateimpact_register.get_hookimpls())
+    for impl in sorted(impls, key=lambda impl: impl.plugin_name not in builtins):
+        attempted: list[tuple[str, str]] = []
+        try:
+            with registry._all_or_nothing(attempted):
+                impl.function(*[arguments[name] for name in impl.argnames])
+        except Exception as exc:
+            where = installed.get(impl.plugin_name)
+            if where is not None:
+                broken.append(BrokenPackage(*where, first_line(exc), tuple(attempted)))
+            elif isinstance(exc, PlateImpactError):
+                raise
+            else:
+                raise PluginError(
+                    f"the plateimpact_register hook of {impl.plugin_name} failed: {first_line(exc)}"
+                ) from exc
+    return broken
 
 
 @functools.cache

@@ -60,6 +60,15 @@ class Simulation:
     ) -> Simulation:
         """Resolve each slot by name from ``registry`` (default: installed plug-ins)."""
         registry = registry or default_registry()
+        if not isinstance(registry, PluginRegistry):
+            raise ParameterError("registry", f"registry must be a PluginRegistry, got {registry!r}")
+        for slot, given in [
+            ("resistance_settings", resistance_settings),
+            ("failure_settings", failure_settings),
+            ("integrator_settings", integrator_settings),
+        ]:
+            if given is not None and not isinstance(given, Mapping):
+                raise ParameterError(slot, f"{slot} must be a mapping, got {given!r:.80}")
         model = ImpactModel(
             resistance=registry.create("resistance", resistance, **(resistance_settings or {})),
             failure=registry.create("failure", failure, **(failure_settings or {})),

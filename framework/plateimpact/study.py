@@ -27,7 +27,11 @@ from .variant import Variant, check_name
 
 
 def _variants(value: Iterable[Variant] | Variant) -> tuple[Variant, ...]:
-    variants = (value,) if isinstance(value, Variant) else tuple(value)
+    given = (value,) if isinstance(value, Variant) else _tuple("variants", value)
+    variants = tuple(v for v in given if isinstance(v, Variant))
+    if len(variants) != len(given):
+        wrong = next(v for v in given if not isinstance(v, Variant))
+        raise ParameterError("variants", f"variants must be Variant objects, got {wrong!r:.80}")
     names = [v.name for v in variants]
     if not variants or len(set(names)) != len(names):
         raise ParameterError(
@@ -41,8 +45,26 @@ def _plate_label(plate: Plate) -> str:
     return f"{plate.material}/{plate.thickness * 1e3:g}"
 
 
+def _tuple(name: str, value: Iterable[object]) -> tuple[object, ...]:
+    """``value``'s items; a string or a non-iterable is a ParameterError naming it."""
+    if isinstance(value, str | bytes):
+        raise ParameterError(name, f"{name} must be a sequence, got the string {value!r}")
+    try:
+        return tuple(value)
+    except TypeError:
+        raise ParameterError(name, f"{name} must be a sequence, got {value!r:.80}") from None
+
+
 def _labels(value: Sequence[str] | np.ndarray) -> tuple[str, ...]:
-    return tuple(str(label) for label in value)
+    return tuple(str(label) for label in _tuple("plate_labels", value))
+
+
+def _scene_batch(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    if not isinstance(value, SceneBatch):
+        raise ParameterError(
+            "scenes",
+            f"scenes must be a SceneBatch (see Study.grid, Study.from_scenes), got {value!r:.80}",
+        )
 
 
 @attrs.frozen(eq=False)
@@ -63,7 +85,7 @@ class Study:
     """
 
     name: str = attrs.field(validator=check_name)
-    scenes: SceneBatch = attrs.field(validator=attrs.validators.instance_of(SceneBatch))
+    scenes: SceneBatch = attrs.field(validator=_scene_batch)
     variants: tuple[Variant, ...] = attrs.field(converter=_variants)
     plate_labels: tuple[str, ...] = attrs.field(converter=_labels)
     description: str = ""
@@ -89,7 +111,14 @@ class Study:
     ) -> Study:
         """Every plate × obliquity [deg] × speed [m/s]; plates by preset name or Plate."""
         batches, labels = [], []
+        plates = _tuple("plates", plates)  # type: ignore[assignment]
+        if not plates:
+            raise ParameterError("plates", "a study grid needs one or more plates")
         for plate in plates:
+            if not isinstance(plate, str | Plate):
+                raise ParameterError(
+                    "plates", f"plates must be preset names or Plate objects, got {plate!r}"
+                )
             label = plate if isinstance(plate, str) else _plate_label(plate)
             plate = presets.plate(plate) if isinstance(plate, str) else plate
             batch = SceneBatch.grid(sphere, plate, speeds, np.radians(obliquities_deg))
@@ -108,8 +137,9 @@ class Study:
     ) -> Study:
         """An explicit list of scenes (custom plates and spheres)."""
         scenes = list(scenes)
+        batch = SceneBatch.from_scenes(scenes)  # checks that they are scenes
         labels = [_plate_label(s.plate) for s in scenes]
-        return cls(name, SceneBatch.from_scenes(scenes), variants, labels, description)
+        return cls(name, batch, variants, labels, description)
 
     @classmethod
     def from_archive(cls, path: str | os.PathLike[str], name: str | None = None) -> Study:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from typing import Any
 
 import attrs
@@ -25,7 +26,13 @@ def _json_value(value: object) -> object:
     raise ParameterError("settings", f"setting value {value!r} is not a JSON value")
 
 
-def _settings(value: dict[str, Any] | None) -> dict[str, Any]:
+def _settings(value: Mapping[str, Any] | None) -> dict[str, Any]:
+    if value is not None and not isinstance(value, Mapping):
+        raise ParameterError(
+            "settings", f"settings must be a mapping of names to values, got {value!r:.80}"
+        )
+    if not all(isinstance(name, str) for name in value or {}):
+        raise ParameterError("settings", f"setting names must be strings, got {list(value or {})}")
     settings: dict[str, Any] = json.loads(
         json.dumps(dict(value or {}), default=_json_value, sort_keys=True)
     )

@@ -5,12 +5,20 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from importlib.metadata import entry_points
+from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..discovery import (
+    BrokenPackage,
+    distribution_label,
+    entry_point_label,
+    first_line,
+    installed_entry_points,
+)
+from ..errors import PluginError
 from ..results import BatchResult, Outcome
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
@@ -67,13 +75,33 @@ def add_parsers(sub: Any) -> None:
 STUDIES_GROUP = "plateimpact.studies"
 
 
-def reproduce_command(args: argparse.Namespace) -> None:
-    found = {entry.name: entry for entry in entry_points(group=STUDIES_GROUP)}
-    if "report" not in found:
-        raise UsageError(
-            f"no study collection 'report' is installed (entry-point group {STUDIES_GROUP})"
+def study_collection(name: str) -> Any:
+    """The object of the ``name`` entry point of :data:`STUDIES_GROUP`; a package that
+    cannot be read or loaded is a one-line PluginError naming its distribution."""
+    found: dict[str, EntryPoint] = {}
+    broken = []
+    for entry in installed_entry_points(STUDIES_GROUP):
+        if isinstance(entry, BrokenPackage):
+            broken.append(f"; {entry.describe()}")
+        else:
+            found.setdefault(entry.name, entry)  # the first on the path, as imports go
+    if name not in found:
+        raise PluginError(
+            f"no study collection {name!r} is installed (entry-point group "
+            f"{STUDIES_GROUP}){''.join(broken)}"
         )
-    reproduce = found["report"].load()
+    entry = found[name]
+    try:
+        return entry.load()
+    except Exception as exc:
+        raise PluginError(
+            f"study collection {name!r} of {distribution_label(entry.dist)} (entry point "
+            f"{entry_point_label(entry)}) failed to load: {first_line(exc)}"
+        ) from None
+
+
+def reproduce_command(args: argparse.Namespace) -> None:
+    reproduce = study_collection("report")
     out = Path(args.out)
     if not str(args.out).strip():
         raise UsageError("--out: give a directory name")

@@ -1,4 +1,5 @@
-"""``presets`` and ``plugins``: what is installed, with every fact from its declaration."""
+"""``presets`` and ``plugins``: what is installed, with every fact from its declaration,
+and the plug-in packages that failed to load."""
 
 from __future__ import annotations
 
@@ -84,3 +85,8 @@ def plugins_command(args: argparse.Namespace) -> None:
         if args.details:
             for name in registry.names(kind):
                 print("\n".join(_details(registry, kind, name)))
+    for package in registry.broken:  # skipped, none of their plug-ins registered
+        print(f"broken: {package.describe()}")
+        if args.details and package.provides:
+            named = ", ".join(f"{kind} {name}" for kind, name in package.provides)
+            print(f"  would provide: {named}")
