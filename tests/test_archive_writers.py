@@ -96,7 +96,7 @@ for k in range(5):
 """
 
 
-@pytest.mark.filterwarnings("ignore::plateimpact.storage.lock.ArchiveWaitWarning")
+@pytest.mark.filterwarnings("ignore::plateimpact.errors.ArchiveWaitWarning")
 def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
     path = tmp_path / "a.h5"
     link = tmp_path / "link.h5"

@@ -100,6 +100,8 @@ _EXPORTS: dict[str, str] = {
     "CalibrationError": "errors",
     "ConvergenceError": "errors",
     "PluginError": "errors",
+    "PlateImpactWarning": "errors",
+    "ArchiveWaitWarning": "errors",
     "PluginLoadWarning": "errors",
 }
 #: Submodules users reach as attributes (``pi.units.mm``).
@@ -149,12 +151,14 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .dynamics import Dynamics
     from .errors import (
         ArchiveError,
+        ArchiveWaitWarning,
         CalibrationError,
         ConvergenceError,
         IntegrationError,
         ParameterError,
         PlateFileError,
         PlateImpactError,
+        PlateImpactWarning,
         PluginError,
         PluginLoadWarning,
         ShotDataError,

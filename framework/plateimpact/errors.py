@@ -63,7 +63,16 @@ class PluginError(PlateImpactError):
     registered. The message names the plug-ins."""
 
 
-class PluginLoadWarning(UserWarning):
+class PlateImpactWarning(UserWarning):
+    """Base class of plateimpact's own warnings: the command line prints each as one line,
+    ``plateimpact: warning: ...``."""
+
+
+class PluginLoadWarning(PlateImpactWarning):
     """An installed plug-in package failed to load and was skipped; the message names
     the distribution, the entry point and the error. Filter it like any warning
     (``warnings.filterwarnings("ignore", category=PluginLoadWarning)``)."""
+
+
+class ArchiveWaitWarning(PlateImpactWarning):
+    """A writer waits for another to finish with an archive, or saved its run aside."""

@@ -14,14 +14,14 @@ import numpy as np
 from . import presets
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
-from .errors import ParameterError, UnknownNameError
+from .errors import ArchiveWaitWarning, ParameterError, UnknownNameError
 from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult, Outcome
 from .scene import Scene
 from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
 from .storage.archive import Archive
-from .storage.lock import ArchiveBusyError, ArchiveWaitWarning
+from .storage.lock import ArchiveBusyError
 from .storage.provenance import RunMetadata
 from .variant import Variant, check_name
 

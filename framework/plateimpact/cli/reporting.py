@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Protocol, TextIO
 
 from ..discovery import first_line
-from ..errors import PluginLoadWarning
+from ..errors import PlateImpactWarning
 from ..storage.provenance import versions
 
 
@@ -49,7 +49,7 @@ def one_line_warnings(shown_before: ShowWarning) -> ShowWarning:
         file: TextIO | None = None,
         line: str | None = None,
     ) -> None:
-        if issubclass(category, PluginLoadWarning):
+        if issubclass(category, PlateImpactWarning):
             print(f"plateimpact: warning: {message}", file=file or sys.stderr)
         else:
             shown_before(message, category, filename, lineno, file, line)

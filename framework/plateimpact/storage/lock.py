@@ -21,7 +21,7 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import ArchiveError
+from ..errors import ArchiveError, ArchiveWaitWarning
 
 #: How often a waiting writer looks again [s].
 POLL = 0.05
@@ -32,10 +32,6 @@ _GUARD = threading.Lock()
 
 class ArchiveBusyError(ArchiveError):
     """The archive stayed locked by another writer longer than the writer could wait."""
-
-
-class ArchiveWaitWarning(UserWarning):
-    """A writer is waiting for another one to finish with the archive."""
 
 
 def _thread_lock(real: Path) -> threading.Lock:
