@@ -6,13 +6,14 @@ see a :class:`SceneBatch`, whose columns are arrays with one entry per scene.
 
 from __future__ import annotations
 
+import reprlib
 from collections.abc import Iterable, Mapping
 
 import numpy as np
 
-from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere, check_density
 from .errors import ParameterError
-from .parameters import Parameter
+from .parameters import Parameter, check_instance
 from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 
 #: The columns every batch has, whatever the model: the sphere, the plate's thickness
@@ -21,6 +22,16 @@ from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 CORE_COLUMNS: dict[str, Parameter] = {
     p.name: p for p in (RADIUS, MASS, THICKNESS, IMPACT_SPEED, IMPACT_OBLIQUITY)
 }
+
+
+def _numbers(name: str, values: object, *, flat: bool = True) -> np.ndarray:
+    """``values`` as a float array (1-D if ``flat``); ParameterError naming the column
+    for anything that is not numbers (text, ragged rows, an int beyond 1.8e308)."""
+    try:
+        array = np.ascontiguousarray(values, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(name, f"{name} must be numbers, got {reprlib.repr(values)}") from None
+    return array.reshape(-1) if flat else array
 
 
 class SceneBatch:
@@ -38,7 +49,9 @@ class SceneBatch:
     size: int
 
     def __init__(self, columns: Mapping[str, object], *, validate: bool = True) -> None:
-        arrays = {k: np.ascontiguousarray(c, dtype=float).reshape(-1) for k, c in columns.items()}
+        if not isinstance(columns, Mapping):
+            raise ParameterError("columns", f"batch columns must be a mapping, got {columns!r}")
+        arrays = {k: _numbers(k, c) for k, c in columns.items()}
         sizes = {a.size for a in arrays.values()}
         if len(sizes) > 1:
             raise ParameterError("columns", f"batch columns differ in length: {sorted(sizes)}")
@@ -47,6 +60,7 @@ class SceneBatch:
                 if name not in arrays:
                     raise ParameterError(name, f"batch column {name!r} is missing")
                 declared.check(arrays[name])
+            check_density(arrays["radius"], arrays["mass"])
             for name, values in arrays.items():
                 if name not in CORE_COLUMNS and np.isnan(values).any():
                     scene = int(np.flatnonzero(np.isnan(values))[0])
@@ -68,6 +82,8 @@ class SceneBatch:
         """Columns from validated :class:`Scene` objects, whose plates must have the same
         constants."""
         scenes = list(scenes)
+        for i, scene in enumerate(scenes):
+            check_instance(f"scene {i}", scene, Scene)
         names = [tuple(k for k, _ in s.plate.constants) for s in scenes]
         for i, found in enumerate(names):
             if found != names[0]:
@@ -100,8 +116,10 @@ class SceneBatch:
         Parameters: speeds [m/s]; obliquities [rad]. Built as arrays, without a Scene
         object per point, so that a 10,000-scene sweep costs no Python loop.
         """
-        speeds = np.asarray(speeds, dtype=float).reshape(-1)
-        obliquities = np.asarray(obliquities, dtype=float).reshape(-1)
+        check_instance("sphere", sphere, Sphere)
+        check_instance("plate", plate, Plate)
+        speeds = _numbers(IMPACT_SPEED.name, speeds)
+        obliquities = _numbers(IMPACT_OBLIQUITY.name, obliquities)
         IMPACT_SPEED.check(speeds)
         IMPACT_OBLIQUITY.check(obliquities)
         obl, spd = np.meshgrid(obliquities, speeds, indexing="ij")
@@ -167,7 +185,13 @@ class SceneBatch:
         """A batch with more (or replaced) columns, each broadcast to the batch size."""
         merged = dict(self._columns)
         for name, values in extra.items():
-            merged[name] = np.broadcast_to(np.asarray(values, dtype=float), (self.size,))
+            array = _numbers(name, values, flat=False)
+            try:
+                merged[name] = np.broadcast_to(array, (self.size,))
+            except ValueError:  # shapes that do not broadcast
+                raise ParameterError(
+                    name, f"column {name!r} has {array.size} values for {self.size} scenes"
+                ) from None
         return SceneBatch(merged, validate=False)
 
     def take(self, index: np.ndarray) -> SceneBatch:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from typing import Any
 
 import attrs
@@ -26,6 +27,8 @@ def _json_value(value: object) -> object:
 
 
 def _settings(value: dict[str, Any] | None) -> dict[str, Any]:
+    if not isinstance(value, Mapping | None):
+        raise ParameterError("settings", f"settings must be a mapping, got {value!r}")
     settings: dict[str, Any] = json.loads(
         json.dumps(dict(value or {}), default=_json_value, sort_keys=True)
     )

@@ -28,7 +28,7 @@ FIXED_STEP = Parameter(
     "fixed_step",
     "a constant step as a fraction of Rs/Vs, without error control (for convergence "
     "studies); none: adaptive",
-    range=Range(0.0, 0.5, low_open=True),
+    range=Range(1e-5, 0.5),  # no finer than the segment method's finest step
     default=None,
     optional=True,
 )

@@ -46,7 +46,7 @@ class Shots:
     Attributes
     ----------
     impact_speed : numpy.ndarray
-        Vs [m/s], > 0.
+        Vs [m/s], in the range of :data:`~plateimpact.scene.IMPACT_SPEED`.
     impact_obliquity : numpy.ndarray
         θs [rad], in [0, π/2).
     residual_speed : numpy.ndarray
@@ -210,8 +210,9 @@ def _check_row(row: Mapping[str, object]) -> tuple[list[float | int], tuple[str,
             return values, (column, f"must be finite, got {raw!r}")
         values.append(x)
     speed, obliquity, residual = values
-    if speed <= 0.0:
-        return values, ("impact_speed_m_s", f"must be > 0 m/s, got {row['impact_speed_m_s']!r}")
+    if not IMPACT_SPEED.range.contains(speed):
+        allowed = IMPACT_SPEED.range.describe(unit=IMPACT_SPEED.user_unit)
+        return values, ("impact_speed_m_s", f"must be {allowed}, got {row['impact_speed_m_s']!r}")
     if not 0.0 <= obliquity < 90.0:
         return values, (
             "impact_obliquity_deg",
