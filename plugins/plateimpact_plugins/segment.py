@@ -10,6 +10,7 @@ import numpy as np
 from plateimpact import (
     KINEMATIC_STATE,
     LATERAL,
+    MAX_SECONDS,
     MAX_STEPS,
     OBLIQUITY,
     PENETRATION,
@@ -101,6 +102,7 @@ class Segment(Integrator):
 
     step: float = STEP.field()
     max_steps: int = attrs.evolve(MAX_STEPS, default=2_500_000).field()
+    max_seconds: float = MAX_SECONDS.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
         return self.SEGMENTS * self.step * dynamics.time_scale
