@@ -113,8 +113,20 @@ class Segment(Integrator):
         dt = h / self.SEGMENTS
         starts = np.empty((self.SEGMENTS, *y.shape))
         rates = np.empty_like(starts)
+        rest_speed = dynamics.batch.core.rest_speed
         current = y
         for j in range(self.SEGMENTS):
-            starts[j], rates[j] = current, dynamics.rates(current)
+            starts[j] = current
+            # A segment longer than the time to stop (a stiff scene at a coarse step)
+            # ends past rest, V <= V_rest: the driver keeps nothing after that event, and
+            # a force evaluated there (V² of a speed far below zero, lift/(m V) of one
+            # near it) would overflow. Such scenes coast on unchanged for the rest of the
+            # step instead.
+            stopped = current[SPEED] <= rest_speed
+            if stopped.any():
+                rates[j] = dynamics.rates(np.where(stopped, y, current))
+                rates[j][:, stopped] = 0.0
+            else:
+                rates[j] = dynamics.rates(current)
             current = arc(current, rates[j], dt)
         return Step(current, h, None, Segments(starts, rates, dt), state)
