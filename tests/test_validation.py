@@ -75,9 +75,8 @@ def test_a_never_failing_plate_is_allowed():
 
 
 def test_batch_columns_are_checked_and_the_scene_is_named():
-    with pytest.raises(
-        pi.ParameterError, match=r"impact_speed must be in \[0.001, 10000\] m/s, got -3 m/s \(scene 1\)"
-    ):
+    expected = r"impact_speed must be in \[0.001, 10000\] m/s, got -3 m/s \(scene 1\)"
+    with pytest.raises(pi.ParameterError, match=expected):
         pi.SceneBatch.grid(SPHERE, PLATE, np.array([10.0, -3.0]), np.array([0.0]))
 
 
