@@ -18,12 +18,12 @@ from .parameters import Parameter, Range
 # The domain (docs/robustness.md, "the input domain"): spheres from a micrometre (fine
 # powder) to a metre; densities of solids that stay rigid, from balsa to past osmium,
 # the densest element (22.6 g/cm³). The mass range is what those allow; the density of
-# a given radius and mass is checked by Sphere itself.
+# a given radius and mass is checked where both are known (check_density).
 RADIUS = Parameter("radius", "sphere radius Rs", "m", Range(1e-6, 1.0), "mm", 1e-3, flag="--radius")
 DENSITY = Parameter("density", "sphere density", "kg/m^3", Range(100.0, 25_000.0))
 MASS = Parameter(
     "mass",
-    "sphere mass m (its density with Rs must be in [100, 25000] kg/m^3)",
+    f"sphere mass m (with Rs, a density {DENSITY.range.describe(unit='kg/m^3')})",
     "kg",
     Range(4e-16, 1.1e5),  # 4/3 π Rs³ ρ at the ends of both ranges, rounded outward
     "g",
