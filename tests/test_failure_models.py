@@ -193,8 +193,8 @@ class TestHingeFinger:
 @pytest.mark.parametrize(
     ("rows", "message"),
     [
-        ([(0, -4.6, 4.6, 0, 0)], "ricochet_pstar_mm must be > 0 mm"),
-        ([(0, 4.6, 0.0, 0, 0)], "perforation_pstar_mm must be > 0 mm"),
+        ([(0, -4.6, 4.6, 0, 0)], "ricochet_pstar_mm must be finite and >= 1e-06 mm"),
+        ([(0, 4.6, 0.0, 0, 0)], "perforation_pstar_mm must be finite and >= 1e-06 mm"),
         ([(45, 3.5, 4.4, 0, 0), (30, 4.0, 4.0, 0, 0)], "strictly increasing, got 30 after 45"),
         ([(45, 3.5, 4.4, 0, 0), (45, 4.0, 4.0, 0, 0)], "strictly increasing"),
         ([(0, 4.6, 4.6, 500, 400)], "0 <= start <= end"),

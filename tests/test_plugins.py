@@ -86,5 +86,5 @@ def test_unknown_names_and_settings_list_the_choices():
     registry = pi.load_registry()
     with pytest.raises(pi.UnknownNameError, match="choose from: .*segment"):
         registry.create("integrator", "rk99")
-    with pytest.raises(pi.ParameterError, match="settings: max_steps, step"):
+    with pytest.raises(pi.ParameterError, match="settings: max_seconds, max_steps, step"):
         registry.create("integrator", "segment", tolerance=1e-6)

@@ -32,6 +32,7 @@ _EXPORTS: dict[str, str] = {
     "StepControl": "integrator",
     "StepperState": "integrator",
     "MAX_STEPS": "integrator",
+    "MAX_SECONDS": "integrator",
     "RTOL": "integrator",
     "Column": "plugin",
     "Dynamics": "dynamics",
@@ -167,7 +168,15 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .failure import FailureModel
     from .geometry import contact_geometry, contact_lost_margin, force_inclination
     from .hookspecs import hookimpl
-    from .integrator import MAX_STEPS, RTOL, Integrator, Step, StepControl, StepperState
+    from .integrator import (
+        MAX_SECONDS,
+        MAX_STEPS,
+        RTOL,
+        Integrator,
+        Step,
+        StepControl,
+        StepperState,
+    )
     from .model import (
         AT_REST,
         CONTACT_LOST,

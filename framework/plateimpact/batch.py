@@ -11,9 +11,9 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
-from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere, check_density
 from .errors import ParameterError
-from .parameters import Parameter
+from .parameters import Parameter, check_instance
 from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 
 #: The columns every batch has, whatever the model: the sphere, the plate's thickness
@@ -24,12 +24,14 @@ CORE_COLUMNS: dict[str, Parameter] = {
 }
 
 
-def _floats(name: str, values: object) -> np.ndarray:
-    """``values`` as a 1-D float array; anything else is a ParameterError naming them."""
+def _numbers(name: str, values: object, *, flat: bool = True) -> np.ndarray:
+    """``values`` as a float array (1-D if ``flat``); ParameterError naming the column
+    for anything that is not numbers (text, ragged rows, an int beyond 1.8e308)."""
     try:
-        return np.ascontiguousarray(values, dtype=float).reshape(-1)
+        array = np.ascontiguousarray(values, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise ParameterError(name, f"{name} must be numbers, got {reprlib.repr(values)}") from None
+    return array.reshape(-1) if flat else array
 
 
 def _batches(batches: Iterable[SceneBatch]) -> list[SceneBatch]:
@@ -62,7 +64,7 @@ class SceneBatch:
             raise ParameterError(
                 "columns", f"a batch takes a mapping of column names to arrays, got {columns!r:.80}"
             )
-        arrays = {k: _floats(k, c) for k, c in columns.items()}
+        arrays = {k: _numbers(k, c) for k, c in columns.items()}
         sizes = {a.size for a in arrays.values()}
         if len(sizes) > 1:
             raise ParameterError("columns", f"batch columns differ in length: {sorted(sizes)}")
@@ -71,6 +73,7 @@ class SceneBatch:
                 if name not in arrays:
                     raise ParameterError(name, f"batch column {name!r} is missing")
                 declared.check(arrays[name])
+            check_density(arrays["radius"], arrays["mass"])
             for name, values in arrays.items():
                 if name not in CORE_COLUMNS and np.isnan(values).any():
                     scene = int(np.flatnonzero(np.isnan(values))[0])
@@ -96,11 +99,7 @@ class SceneBatch:
         except TypeError:
             scenes = [scenes]  # type: ignore[list-item]  # reported below
         for i, scene in enumerate(scenes):
-            if not isinstance(scene, Scene):
-                raise ParameterError(
-                    "scenes",
-                    f"expected a SceneBatch or Scene objects, got {scene!r:.80} (item {i})",
-                )
+            check_instance(f"scene {i}", scene, Scene)
         names = [tuple(k for k, _ in s.plate.constants) for s in scenes]
         for i, found in enumerate(names):
             if found != names[0]:
@@ -133,13 +132,10 @@ class SceneBatch:
         Parameters: speeds [m/s]; obliquities [rad]. Built as arrays, without a Scene
         object per point, so that a 10,000-scene sweep costs no Python loop.
         """
-        if not (isinstance(sphere, Sphere) and isinstance(plate, Plate)):
-            raise ParameterError(
-                "sphere" if not isinstance(sphere, Sphere) else "plate",
-                f"grid takes a Sphere and a Plate, got {sphere!r:.60} and {plate!r:.60}",
-            )
-        speeds = _floats("impact_speed", speeds)
-        obliquities = _floats("impact_obliquity", obliquities)
+        check_instance("sphere", sphere, Sphere)
+        check_instance("plate", plate, Plate)
+        speeds = _numbers(IMPACT_SPEED.name, speeds)
+        obliquities = _numbers(IMPACT_OBLIQUITY.name, obliquities)
         IMPACT_SPEED.check(speeds)
         IMPACT_OBLIQUITY.check(obliquities)
         obl, spd = np.meshgrid(obliquities, speeds, indexing="ij")
@@ -205,12 +201,12 @@ class SceneBatch:
         """A batch with more (or replaced) columns, each broadcast to the batch size."""
         merged = dict(self._columns)
         for name, values in extra.items():
-            array = _floats(name, values)
+            array = _numbers(name, values, flat=False)
             try:
                 merged[name] = np.broadcast_to(array, (self.size,))
-            except ValueError:  # not one value and not one per scene
+            except ValueError:  # shapes that do not broadcast
                 raise ParameterError(
-                    name, f"column {name!r} needs 1 or {self.size} values, got {array.size}"
+                    name, f"column {name!r} has {array.size} values for {self.size} scenes"
                 ) from None
         return SceneBatch(merged, validate=False)
 

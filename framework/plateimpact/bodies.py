@@ -15,20 +15,56 @@ import numpy as np
 from .errors import ParameterError
 from .parameters import Parameter, Range
 
-RADIUS = Parameter(
-    "radius", "sphere radius Rs", "m", Range(0.0, low_open=True), "mm", 1e-3, flag="--radius"
+# The domain (docs/robustness.md, "the input domain"): spheres from a micrometre (fine
+# powder) to a metre; densities of solids that stay rigid, from balsa to past osmium,
+# the densest element (22.6 g/cm³). The mass range is what those allow; the density of
+# a given radius and mass is checked where both are known (check_density).
+RADIUS = Parameter("radius", "sphere radius Rs", "m", Range(1e-6, 1.0), "mm", 1e-3, flag="--radius")
+DENSITY = Parameter("density", "sphere density", "kg/m^3", Range(100.0, 25_000.0))
+MASS = Parameter(
+    "mass",
+    f"sphere mass m (with Rs, a density {DENSITY.range.describe(unit='kg/m^3')})",
+    "kg",
+    Range(4e-16, 1.1e5),  # 4/3 π Rs³ ρ at the ends of both ranges, rounded outward
+    "g",
+    1e-3,
+    flag="--mass",
 )
-MASS = Parameter("mass", "sphere mass m", "kg", Range(0.0, low_open=True), "g", 1e-3, flag="--mass")
-DENSITY = Parameter("density", "sphere density", "kg/m^3", Range(0.0, low_open=True))
+# Foils of a micrometre to armour a metre thick.
 THICKNESS = Parameter(
     "thickness",
     "plate thickness T (not in the force law: it bounds crater sections)",
     "m",
-    Range(0.0, low_open=True),
+    Range(1e-6, 1.0),
     "mm",
     1e-3,
     flag="--thickness",
 )
+#: A density computed from a radius and a mass may round across a bound of DENSITY
+#: that the density it was made from met (Sphere.of_density at the bounds).
+_DENSITY_ROUNDING = 1e-12
+
+
+def check_density(radius: Any, mass: Any) -> None:
+    """Raise :class:`ParameterError` unless spheres of ``radius`` [m] and ``mass`` [kg],
+    each in its range, have a solid's density (:data:`DENSITY`); an array names the
+    first bad scene. Named after the mass: any radius alone is a possible sphere."""
+    radius, mass = np.asarray(radius, dtype=float), np.asarray(mass, dtype=float)
+    density = mass / (4.0 / 3.0 * math.pi * radius**3)
+    allowed = DENSITY.range
+    low, high = allowed.low * (1 - _DENSITY_ROUNDING), allowed.high * (1 + _DENSITY_ROUNDING)
+    bad = ~((density >= low) & (density <= high))
+    if not bad.any():
+        return
+    first = int(np.flatnonzero(bad)[0]) if bad.ndim else 0
+    where = f" (scene {first})" if bad.ndim else ""
+    r, m, d = (float(np.ravel(x)[first]) for x in (radius, mass, density))
+    raise ParameterError(
+        MASS.name,
+        f"mass {MASS.format(m)} g on radius {RADIUS.format(r)} mm gives a density of "
+        f"{DENSITY.format(d)} kg/m^3; the sphere's density must be "
+        f"{allowed.describe(unit='kg/m^3')}{where}",
+    )
 
 
 @attrs.frozen
@@ -38,13 +74,16 @@ class Sphere:
     Parameters
     ----------
     radius : float
-        Rs [m], > 0.
+        Rs [m], in [1e-6, 1].
     mass : float
-        m [kg], > 0.
+        m [kg]; its mean density with ``radius`` in [100, 25000] kg/m³.
     """
 
     radius: float = RADIUS.field()
     mass: float = MASS.field()
+
+    def __attrs_post_init__(self) -> None:
+        check_density(self.radius, self.mass)
 
     @classmethod
     def of_density(cls, radius: float, density: float) -> Sphere:
@@ -65,9 +104,35 @@ def _constant(name: str, value: Any) -> float:
     if not isinstance(name, str) or not name.isidentifier():
         raise ParameterError(str(name), f"plate constant names are identifiers, got {name!r}")
     number = isinstance(value, int | float | np.integer | np.floating)
-    if isinstance(value, bool | np.bool_) or not number or math.isnan(value):
+    if isinstance(value, bool | np.bool_) or not number:
         raise ParameterError(name, f"{name} must be a number, got {value!r}")
-    return float(value)
+    try:
+        as_float = float(value)
+    except OverflowError:  # an int beyond 1.8e308
+        raise ParameterError(name, f"{name} must be a finite number or inf") from None
+    if math.isnan(as_float):
+        raise ParameterError(name, f"{name} must be a number, got {value!r}")
+    return as_float
+
+
+def _named_constants(
+    constants: Mapping[str, float] | Iterable[tuple[str, float]], named: Mapping[str, float]
+) -> tuple[tuple[str, float], ...]:
+    """(name, SI value) pairs sorted by name, from a mapping or pairs and keywords."""
+    try:
+        merged = dict(constants)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            "constants",
+            f"plate constants must be a mapping or (name, value) pairs, got {constants!r}",
+        ) from None
+    merged.update(named)
+    return tuple(sorted((name, _constant(name, value)) for name, value in merged.items()))
+
+
+def _material(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    if not isinstance(value, str):
+        raise ParameterError("material", f"material must be a label (str), got {value!r}")
 
 
 @attrs.frozen(init=False)
@@ -85,13 +150,13 @@ class Plate:
     material : str
         A label, e.g. ``"2024-T3"``.
     thickness : float
-        T [m], > 0. The report's force law has no back surface: T enters the model only
+        T [m], in [1e-6, 1]. The report's force law has no back surface: T enters the model only
         through the fitted constants; plateimpact uses it to bound crater sections.
     constants : mapping or pairs, optional
         Constants by name [SI]; keyword arguments add to them (``a=0.272e9``).
     """
 
-    material: str = attrs.field(validator=attrs.validators.instance_of(str))
+    material: str = attrs.field(validator=_material)
     thickness: float = THICKNESS.field()
     #: (name, SI value) pairs, sorted by name.
     constants: tuple[tuple[str, float], ...] = attrs.field(default=())
@@ -103,10 +168,7 @@ class Plate:
         constants: Mapping[str, float] | Iterable[tuple[str, float]] = (),
         **named: float,
     ) -> None:
-        merged = dict(constants)
-        merged.update(named)
-        pairs = tuple(sorted((name, _constant(name, value)) for name, value in merged.items()))
-        self.__attrs_init__(material, thickness, pairs)
+        self.__attrs_init__(material, thickness, _named_constants(constants, named))
 
     def __getattr__(self, name: str) -> float:
         if name.startswith("_") or name == "constants":

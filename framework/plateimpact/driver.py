@@ -9,6 +9,8 @@ recording, and dropping finished scenes. The integrator only steps
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from .batch import SceneBatch
@@ -53,9 +55,37 @@ def _select(accepted: np.ndarray, new: StepperState, old: StepperState) -> Stepp
     return {key: np.where(accepted, new[key], old[key]) for key in old}
 
 
+def _unfinished(
+    integrator: Integrator, limit: str, setting: str, example: str, scene: np.ndarray, where: str
+) -> IntegrationError:
+    """The one-line error of a scene that exhausted a work bound: how far it got, and the
+    setting to raise (on the command line too, where the integrator declares it)."""
+    if setting in integrator.setting_declarations():
+        change = f"raise {setting} (--set integrator.{setting}={example})"
+    else:
+        change = f"raise the integrator's {setting}"
+    return IntegrationError(
+        f"{integrator.name}: {scene.size} scene(s) unfinished after {limit} (first: scene "
+        f"{int(scene[0])}, {where}); {change}"
+    )
+
+
+def _progress(y: np.ndarray, t: np.ndarray, batch: BoundBatch, stats: dict) -> str:
+    """Where the first unfinished scene is, in its own scales (Rs, Vs, Rs/Vs)."""
+    core = batch.core
+    radius, speed = core.radius[0], core.impact_speed[0]
+    return (
+        f"at P = {y[PENETRATION, 0] / radius:.3g} Rs, V = {y[SPEED, 0] / speed:.3g} Vs, "
+        f"t = {t[0] * speed / radius:.3g} Rs/Vs after {stats['steps']} steps"
+    )
+
+
 def _integrate(
     model: ImpactModel, integrator: Integrator, batch: BoundBatch, recorder: ResultRecorder
 ) -> None:
+    # The wall-time bound: each pass of the loop is charged in equal shares to the scenes
+    # it advanced, so `used` is the time each scene still running has cost so far.
+    last, used, running = time.perf_counter(), 0.0, batch.size
     n = batch.size
     width = KINEMATIC_STATE + len(model.failure.state_names)
     scene = np.arange(n)
@@ -80,6 +110,13 @@ def _integrate(
     margins_now, known = np.empty((5, n)), np.zeros(n, bool)
 
     for _ in range(integrator.max_steps):
+        now = time.perf_counter()
+        used += (now - last) / running
+        last, running = now, scene.size
+        if used > integrator.max_seconds:
+            limit = f"max_seconds={integrator.max_seconds:g} s of wall time"
+            where = _progress(y, t, batch, stats)
+            raise _unfinished(integrator, limit, "max_seconds", "SECONDS", scene, where)
         stats["steps"] += 1
         step = integrator.advance(dynamics, t, y, sizes.propose(dynamics, y, state), state)
         ok = sizes.judge(step, y)
@@ -174,8 +211,6 @@ def _integrate(
             state = {key: values[..., keep] for key, values in state.items()}
             sizes.take(keep)
             dynamics = Dynamics(model, batch, failed, held, stats)
-    raise IntegrationError(
-        f"{integrator.name}: {scene.size} scene(s) unfinished after max_steps="
-        f"{integrator.max_steps} steps (first: scene {int(scene[0])}); raise max_steps "
-        "(--set integrator.max_steps=N)"
-    )
+    limit = f"max_steps={integrator.max_steps} steps"
+    where = _progress(y, t, batch, stats)
+    raise _unfinished(integrator, limit, "max_steps", "N", scene, where)

@@ -18,10 +18,12 @@ from .plugin import Plugin
 from .resistance import BoundResistance, ResistanceLaw, contact_force
 from .results import Outcome
 
+# At 1e-6 Vs a sphere has 1e-12 of its energy left; below, the rule would only chase
+# dθ/dt = lift/(m V), which grows without bound as V falls.
 REST_SPEED_FRACTION = Parameter(
     "rest_speed_fraction",
     "a sphere is at rest when its speed falls to this fraction of its impact speed",
-    range=Range(0.0, 1.0, True, True),
+    range=Range(1e-6, 1.0, high_open=True),
     default=1e-2,
 )
 ONSET_PENETRATION = Parameter(

@@ -198,12 +198,10 @@ class Parameter:
             return
         values = np.asarray(value, dtype=float)
         first = float(values[~ok].ravel()[0]) if values.ndim else float(values)
-        unit = "" if self.user_unit == "1" else f" {self.user_unit}"
+        unit = "" if self.user_unit == "1" else self.user_unit
         where = f" (scene {int(np.flatnonzero(~ok)[0])})" if values.ndim else ""
-        raise self.error(
-            f"{self.range.describe(self.scale, self.user_unit)}, "
-            f"got {_fmt(first / self.scale)}{unit}{where}"
-        )
+        got = f"{_fmt(first / self.scale)} {unit}".rstrip()
+        raise self.error(f"{self.range.describe(self.scale, unit)}, got {got}{where}")
 
     def validate(self, value: Any) -> Any:
         """A Python value (SI) checked against the declaration and converted to its kind."""
@@ -223,13 +221,18 @@ class Parameter:
         if isinstance(value, bool | np.bool_) or not number:
             kind = "an integer" if self.kind is int else "a number"
             raise self.error(f"{kind}, got {value!r}")
+        try:
+            as_float = float(value)  # an int beyond 1.8e308 has no float: out of any range
+        except OverflowError:
+            raise self.error(f"{self.describe_range()}, got an integer beyond 1.8e308") from None
         if self.kind is int:
-            if float(value) != int(value):
+            whole = isinstance(value, int | np.integer) or as_float.is_integer()
+            if not whole:  # 1.5, inf and nan alike
                 raise self.error(f"an integer, got {value!r}")
-            self.check(int(value))
+            self.check(as_float)
             return int(value)
-        self.check(float(value))
-        return float(value)
+        self.check(as_float)
+        return as_float
 
     def parse(self, text: str) -> Any:
         """A value from command-line text in the user's unit (``3.0`` mm -> 3e-3 m)."""
@@ -260,6 +263,12 @@ class Parameter:
             kwargs["default"] = self.default
         metadata = {**kwargs.pop("metadata", {}), "parameter": self}
         return attrs.field(converter=self.validate, metadata=metadata, **kwargs)
+
+
+def check_instance(name: str, value: object, kind: type) -> None:
+    """Raise :class:`ParameterError` naming ``name`` unless ``value`` is a ``kind``."""
+    if not isinstance(value, kind):
+        raise ParameterError(name, f"{name} must be a {kind.__name__}, got {value!r}")
 
 
 def parameter_of(field: attrs.Attribute) -> Parameter | None:

@@ -70,11 +70,14 @@ class Simulation:
             if given is not None and not isinstance(given, Mapping):
                 raise ParameterError(slot, f"{slot} must be a mapping, got {given!r:.80}")
         model = ImpactModel(
-            resistance=registry.create("resistance", resistance, **(resistance_settings or {})),
-            failure=registry.create("failure", failure, **(failure_settings or {})),
+            resistance=registry.create(
+                "resistance", resistance, **_settings("resistance", resistance_settings)
+            ),
+            failure=registry.create("failure", failure, **_settings("failure", failure_settings)),
             rest_speed_fraction=rest_speed_fraction,
         )
-        return cls(model, registry.create("integrator", integrator, **(integrator_settings or {})))
+        settings = _settings("integrator", integrator_settings)
+        return cls(model, registry.create("integrator", integrator, **settings))
 
     def run_batch(
         self,
@@ -127,6 +130,17 @@ class Simulation:
             "integrator_version": self.integrator.version,
             "integrator_settings": self.integrator.settings(),
         }
+
+
+def _settings(kind: str, settings: object) -> dict[str, Any]:
+    """A slot's settings: a mapping of names to values (None: none)."""
+    if settings is None:
+        return {}
+    if not isinstance(settings, Mapping):
+        raise ParameterError(
+            f"{kind}_settings", f"{kind}_settings must be a mapping, got {settings!r}"
+        )
+    return dict(settings)
 
 
 def check_chunk_size(chunk_size: object) -> None:

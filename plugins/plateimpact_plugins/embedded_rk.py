@@ -8,6 +8,7 @@ import attrs
 import numpy as np
 
 from plateimpact import (
+    MAX_SECONDS,
     MAX_STEPS,
     RTOL,
     DenseOutput,
@@ -28,7 +29,7 @@ FIXED_STEP = Parameter(
     "fixed_step",
     "a constant step as a fraction of Rs/Vs, without error control (for convergence "
     "studies); none: adaptive",
-    range=Range(0.0, 0.5, low_open=True),
+    range=Range(1e-5, 0.5),  # no finer than the segment method's finest step
     default=None,
     optional=True,
 )
@@ -100,6 +101,7 @@ class EmbeddedRungeKutta(Integrator):
 
     rtol: float = RTOL.field()
     max_steps: int = MAX_STEPS.field()
+    max_seconds: float = MAX_SECONDS.field()
     fixed_step: float | None = FIXED_STEP.field()
     branch_landing: bool = BRANCH_LANDING.field()
 

@@ -17,7 +17,7 @@ HALF_PI = 0.5 * np.pi
 FINGER_AREA_SCALE = Parameter(
     "finger_area_scale",
     "multiplies the finger's presented area As (0: no finger, i.e. plugging)",
-    range=Range(0.0),
+    range=Range(0.0, 10.0),  # a sensitivity factor: 10x the finger is no longer a hinge
     default=1.0,
 )
 HINGE_OBLIQUITY = Parameter(

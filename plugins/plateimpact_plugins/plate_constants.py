@@ -10,25 +10,30 @@ import math
 
 from plateimpact import Parameter, Range
 
+# The ranges (docs/robustness.md, "the input domain"): a is about three times a
+# material's flow stress, from soft clays and gels (1e5 N/m², 30 kPa) to past diamond's
+# hardness (1e11 N/m², 100 GPa); b is of the order of the plate's density, none denser
+# than 1e5 kg/m³; P* is a depth in the plate, from a nanometre (an atomic layer) up,
+# inf for a plate that never fails.
 STRENGTH_A = Parameter(
     "a",
     "Poncelet strength term a (eq 1)",
     "N/m^2",
-    Range(0.0, low_open=True),
+    Range(1e5, 1e11),
     flag="--a",
 )
 DENSITY_B = Parameter(
     "b",
     "Poncelet inertial term b (eq 1)",
     "kg/m^3",
-    Range(0.0),
+    Range(0.0, 1e5),
     flag="--b",
 )
 CRITICAL_PENETRATION = Parameter(
     "critical_penetration",
     "critical penetration P*: the plate fails when the penetration reaches it (inf: never)",
     "m",
-    Range(0.0, low_open=True, allow_inf=True),
+    Range(1e-9, allow_inf=True),
     "mm",
     1e-3,
     flag="--pstar",

@@ -8,6 +8,7 @@ import attrs
 import numpy as np
 
 from plateimpact import (
+    MAX_SECONDS,
     MAX_STEPS,
     RTOL,
     DenseOutput,
@@ -75,6 +76,7 @@ class ScipyIVP(Integrator):
     method: str = METHOD.field()
     rtol: float = attrs.evolve(RTOL, default=1e-10).field()
     max_steps: int = MAX_STEPS.field()
+    max_seconds: float = MAX_SECONDS.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
         return np.full(dynamics.size, np.nan)  # the solvers choose their own

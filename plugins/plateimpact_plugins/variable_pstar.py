@@ -13,7 +13,11 @@ import numpy as np
 
 from plateimpact import Parameter, ParameterError, SceneBatch
 
+from .plate_constants import CRITICAL_PENETRATION
 from .separation import PlaneSeparation
+
+#: The smallest P* of a row [mm]: the plate constant's.
+SMALLEST_PSTAR_MM = CRITICAL_PENETRATION.range.low / CRITICAL_PENETRATION.scale
 
 TABLE_COLUMNS = (
     "obliquity_deg",
@@ -40,7 +44,7 @@ class PstarTable:
     value below the band, the perforation value above it, linear inside it.
 
     Attributes are SI arrays: obliquity [rad] (strictly increasing), ricochet and
-    perforation [m] (> 0), transition_start <= transition_end [m/s] (>= 0). Build one in
+    perforation [m] (>= 1e-9, as P*), transition_start <= transition_end [m/s] (>= 0). Build one in
     user units with :meth:`from_rows` or :meth:`from_csv`.
     """
 
@@ -72,8 +76,11 @@ class PstarTable:
                 ("ricochet_pstar_mm", ricochet),
                 ("perforation_pstar_mm", perforation),
             ):
-                if not (math.isfinite(value) and value > 0.0):
-                    raise _fail(f"row {number}: {name} must be > 0 mm, got {value:g}")
+                if not (math.isfinite(value) and value >= SMALLEST_PSTAR_MM):
+                    raise _fail(
+                        f"row {number}: {name} must be finite and >= {SMALLEST_PSTAR_MM:g} mm, "
+                        f"got {value:g}"
+                    )
             if not (math.isfinite(start) and math.isfinite(end) and 0.0 <= start <= end):
                 raise _fail(
                     f"row {number}: transition speeds must satisfy 0 <= start <= end m/s, "

@@ -15,7 +15,15 @@ from ..presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
-from .start import energy_balance_start, fit_model_dri, model_residual_speeds, normal_shots
+from .start import (
+    check_start,
+    energy_balance_start,
+    fit_model_dri,
+    in_model_domain,
+    log_domain,
+    model_residual_speeds,
+    normal_shots,
+)
 
 #: Relative step of a and b for the finite differences of eqs 44–47 (and the direct fit).
 DIFFERENCE_STEP = 1e-3
@@ -24,7 +32,8 @@ DIFFERENCE_STEP = 1e-3
 NEWTON_TOLERANCE = 1e-6
 #: Newton steps allowed before :class:`ConvergenceError`.
 MAX_NEWTON_ITERATIONS = 20
-#: Halvings of one Newton step that leaves a, b > 0 or the model's perforations.
+#: Halvings of one Newton step that leaves the model's range of a and b (a, b > 0 and
+#: their declared ranges) or the model's perforations.
 MAX_HALVINGS = 30
 #: The direct fit keeps a and b within this factor of its start.
 DIRECT_BOUND_FACTOR = 1e3
@@ -116,6 +125,7 @@ def newton_fit(
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds = normal.impact_speed
     a, b = start or energy_balance_start(target.R, target.V0, sphere, plate)
+    check_start(simulation, a, b)
     scale = np.array([target.R, target.V0])  # relative differences, eqs 48–49 scaled
 
     def evaluate(a: float, b: float) -> tuple[np.ndarray, list[DriFit] | None]:
@@ -151,7 +161,7 @@ def newton_fit(
             ) from None
         for _ in range(MAX_HALVINGS):
             trial = a * (1 + correction[0]), b * (1 + correction[1])
-            if min(trial) > 0.0:
+            if in_model_domain(simulation, *trial):
                 trial_residual, trial_fits = evaluate(*trial)
                 if trial_fits is not None:
                     break
@@ -160,7 +170,7 @@ def newton_fit(
             raise ConvergenceError(
                 _not_converged(
                     f"after {iterations} iterations a step halved {MAX_HALVINGS} times still "
-                    "left a, b > 0 or the model's perforations",
+                    "left the model's range of a and b or its perforations",
                     fits[0],
                     target,
                 )
@@ -210,15 +220,17 @@ def direct_fit(
     speed 0), with :func:`scipy.optimize.least_squares` in the variables ln a, ln b (both
     act as relative changes, so the Jacobian's columns are of one size, and a, b > 0
     holds by construction), bounded within a factor 1000 of ``start`` (default: the
-    Newton start). The Jacobian is a finite difference with relative step ``step``, its
-    two extra model runs in one batch. Standard errors from s² (JᵀJ)⁻¹, s² the residual
-    variance over the shots that carry one (those the data or the model perforates).
+    Newton start) and within the model's ranges of a and b. The Jacobian is a finite
+    difference with relative step ``step``, its two extra model runs in one batch.
+    Standard errors from s² (JᵀJ)⁻¹, s² the residual variance over the shots that carry
+    one (those the data or the model perforates).
     """
     simulation = simulation or Simulation.from_names()
     normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds, measured = normal.impact_speed, normal.residual_speed
     a0, b0 = start or energy_balance_start(target.R, target.V0, sphere, plate)
+    check_start(simulation, a0, b0)
     cache: dict[bytes, np.ndarray] = {}
 
     def residuals(x: np.ndarray) -> np.ndarray:
@@ -239,11 +251,13 @@ def direct_fit(
 
     bound = math.log(DIRECT_BOUND_FACTOR)
     x0 = np.array([math.log(a0), math.log(b0)])
+    low, high = log_domain(simulation)  # a trial outside would be refused by the model
+    lower, upper = np.maximum(x0 - bound, low), np.minimum(x0 + bound, high)
     solution = least_squares(
         residuals,
         x0,
         jac=jacobian,
-        bounds=(x0 - bound, x0 + bound),
+        bounds=(lower, upper),
         method="trf",
         xtol=1e-10,
         ftol=1e-12,
@@ -251,10 +265,15 @@ def direct_fit(
         max_nfev=max_evaluations,
     )
     a, b = (float(v) for v in np.exp(solution.x))
-    at_bound = np.any(np.abs(solution.x - x0) > bound * (1 - 1e-9))
+    edge = 1e-9 * bound
+    at_bound = np.any((solution.x < lower + edge) | (solution.x > upper - edge))
     converged = solution.status > 0 and not at_bound
     if not converged and raise_on_failure:
-        reason = "reached the bound 1000x the start" if at_bound else solution.message
+        reason = (
+            "reached a bound (1000x the start, or the model's range of a and b)"
+            if at_bound
+            else solution.message
+        )
         raise ConvergenceError(f"direct fit of a and b did not converge: {reason}")
     J = solution.jac
     carrying = (np.abs(solution.fun) > 0.0) | np.any(J != 0.0, axis=1)

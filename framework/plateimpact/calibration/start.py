@@ -13,6 +13,7 @@ from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
 from ..errors import CalibrationError, ShotDataError
 from ..geometry import contact_geometry
+from ..parameters import Range
 from ..results import Outcome
 from ..simulation import Simulation
 from ..storage.shots import Shots
@@ -107,3 +108,40 @@ def fit_model_dri(speeds: np.ndarray, residual: np.ndarray) -> DriFit | None:
         return fit_dri(speeds, residual)
     except CalibrationError:
         return None
+
+
+def _declared_ranges(simulation: Simulation) -> list[tuple[str, Range | None]]:
+    declared = simulation.model.plate_constants()
+    return [(name, declared[name].range if name in declared else None) for name in ("a", "b")]
+
+
+def in_model_domain(simulation: Simulation, a: float, b: float) -> bool:
+    """Whether a, b > 0 (the fits work in ln a, ln b) lie in the ranges the model
+    declares for them, where a trial of either fit may be run."""
+    ranges = _declared_ranges(simulation)
+    return all(
+        value > 0.0 and (allowed is None or bool(allowed.contains(value)))
+        for value, (_, allowed) in zip((a, b), ranges, strict=True)
+    )
+
+
+def log_domain(simulation: Simulation) -> tuple[np.ndarray, np.ndarray]:
+    """The model's ranges of a and b as bounds on (ln a, ln b)."""
+    low, high = np.full(2, -np.inf), np.full(2, np.inf)
+    for k, (_, allowed) in enumerate(_declared_ranges(simulation)):
+        if allowed is not None:
+            with np.errstate(divide="ignore"):  # ln 0 = -inf: no lower bound
+                low[k], high[k] = np.log(allowed.low), np.log(allowed.high)
+    return low, high
+
+
+def check_start(simulation: Simulation, a: float, b: float) -> None:
+    """CalibrationError unless the start (a, b) lies in the model's domain."""
+    if not in_model_domain(simulation, a, b):
+        allowed = ", ".join(
+            f"{name} {r.describe()}" for name, r in _declared_ranges(simulation) if r is not None
+        )
+        raise CalibrationError(
+            f"the start a = {a:.4g} N/m^2, b = {b:.4g} kg/m^3 from the shots' R and V0 lies "
+            f"outside the model's range (a, b > 0; {allowed}): no plate of this model fits them"
+        )

@@ -40,6 +40,11 @@ SWEEP_COLUMNS = (
 )
 
 
+#: The largest sweep: a million scenes take a few minutes and a few hundred MB; a larger
+#: grid belongs in a study, which runs in chunks and keeps what it finished.
+MAX_SWEEP_SCENES = 1_000_000
+
+
 def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     commands = [
         ("run", run_command, "run one scene"),
@@ -143,17 +148,21 @@ def crater_command(args: argparse.Namespace) -> None:
 
 def _parse_speeds(text: str) -> np.ndarray:
     try:
-        if ":" in text:
-            start, stop, count = text.split(":")
-            n = int(count)
-            if n < 1:
-                raise ValueError
-            return np.linspace(float(start), float(stop), n)
-        return np.array([float(x) for x in text.split(",")])
+        if ":" not in text:
+            return np.array([float(x) for x in text.split(",")])
+        start, stop, count = text.split(":")
+        ends, n = (float(start), float(stop)), int(count)
+        if n < 1:
+            raise ValueError
     except ValueError:
         raise UsageError(
             f"--speeds must be START:STOP:N (N >= 1) or a comma list in m/s, got {text!r}"
         ) from None
+    for end in ends:  # before linspace, which turns an infinite end into NaNs
+        IMPACT_SPEED.check(end)
+    if n > MAX_SWEEP_SCENES:
+        raise UsageError(f"--speeds: N must be <= {MAX_SWEEP_SCENES}, got {n}")
+    return np.linspace(*ends, n)
 
 
 def _parse_obliquities(text: str) -> np.ndarray:
@@ -170,6 +179,11 @@ def sweep_command(args: argparse.Namespace) -> None:
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)
     speeds, obliquities = _parse_speeds(args.speeds), _parse_obliquities(args.obliquities)
+    if speeds.size * obliquities.size > MAX_SWEEP_SCENES:
+        raise UsageError(
+            f"--speeds, --obliquities: a sweep runs at most {MAX_SWEEP_SCENES} scenes, got "
+            f"{speeds.size} x {obliquities.size} (run more as a study, in chunks)"
+        )
     batch = SceneBatch.grid(sphere, plate, speeds, obliquities * IMPACT_OBLIQUITY.scale)
     result = simulation.run_batch(batch)
     # Echo the values as typed (the grid is obliquity-major), not their round trip via SI.

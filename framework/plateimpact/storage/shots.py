@@ -46,7 +46,7 @@ class Shots:
     Attributes
     ----------
     impact_speed : numpy.ndarray
-        Vs [m/s], > 0.
+        Vs [m/s], in the range of :data:`~plateimpact.scene.IMPACT_SPEED`.
     impact_obliquity : numpy.ndarray
         θs [rad], in [0, π/2).
     residual_speed : numpy.ndarray
