@@ -184,11 +184,14 @@ def test_an_archive_in_a_read_only_place_is_one_line(tmp_path):
             tiny_study().run(archive=disk / "a.h5")
 
 
-@pytest.mark.parametrize("argument", ["", ".", "/"])
-def test_show_of_what_is_not_an_archive_file_is_one_line(argument, tmp_path, monkeypatch):
+@pytest.mark.parametrize(
+    ("argument", "words"),
+    [("", "give an archive file name, got ''"), (".", "not a file"), ("/", "not a file")],
+)
+def test_show_of_what_is_not_an_archive_file_is_one_line(argument, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, _, err = run_cli(["show", argument])
-    assert_one_line(code, err)
+    assert_one_line(code, err, words)
 
 
 def test_a_full_disk_during_an_append_keeps_the_archive_and_is_one_line(tmp_path):

@@ -114,6 +114,27 @@ def test_shots_outside_the_speed_range_are_refused_by_file_line_and_column(tmp_p
     assert "impact_speed_m_s" in err and "in [0.001, 10000] m/s" in err and "20000" in err
 
 
+@pytest.mark.parametrize(
+    ("rows", "named"),
+    [
+        # Issue 15: speeds near 1e300 overflowed Vs² inside the fit (a traceback).
+        (["1e300,0,5e299", "2e300,0,1e300", "3e300,0,2e300"], "line 2, column impact_speed_m_s"),
+        # Three shots within 2e-7 m/s: Eq 41's line through (Vs², Vr²) has no slope.
+        (
+            ["500,0,300", "500.0000001,0,300.0000001", "500.0000002,0,300.0000002"],
+            "perforating shots at different impact speeds",
+        ),
+    ],
+)
+def test_calibration_shots_that_fix_no_fit_are_one_line(rows, named, tmp_path, capsys):
+    shots = tmp_path / "shots.csv"
+    shots.write_text("impact_speed_m_s,impact_obliquity_deg,residual_speed_m_s\n" + "\n".join(rows))
+    argv = ["calibrate", str(shots), *CALIBRATE[2:], "--out", str(tmp_path / "p.json")]
+    err = one_error_line(argv, capsys)
+    assert named in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shots.csv"]
+
+
 # -- the work bounds -------------------------------------------------------------------
 
 
@@ -131,6 +152,15 @@ def test_the_step_bound_says_where_the_scene_got_to(integrator, capsys):
     assert f"{integrator}: 1 scene(s) unfinished after max_steps=3 steps" in err
     assert "(first: scene 0, at P = " in err and "after 3 steps" in err
     assert "raise max_steps (--set integrator.max_steps=N)" in err
+
+
+def test_solve_ivps_end_time_is_a_setting_its_message_names(capsys):
+    # This contact lasts about 4 Rs/Vs (25 us; Rs/Vs = 6.35 us): a phase outlasts 1 Rs/Vs.
+    args = [*RUN, "--integrator", "solve_ivp", "--set", "integrator.longest_phase=1"]
+    err = one_error_line(args, capsys)
+    assert "solve_ivp: a scene unfinished after longest_phase=1 Rs/Vs" in err
+    assert "(--set integrator.longest_phase=MULTIPLE)" in err
+    assert main([*RUN, "--integrator", "solve_ivp"]) == 0
 
 
 def test_every_builtin_integrator_declares_both_work_bounds():

@@ -16,16 +16,25 @@ from plateimpact import (
     IntegrationError,
     Integrator,
     Parameter,
+    Range,
     Step,
     StepperState,
 )
 
 METHODS = ("DOP853", "RK45", "RK23", "LSODA", "Radau", "BDF")
-#: A scene that has not ended after this many Rs/Vs is an error, not an outcome.
-LONGEST_PHASE = 1e4
 
 METHOD = Parameter(
     "method", "the scipy.integrate solver", kind=str, choices=METHODS, default="DOP853"
+)
+# Each solver is built with an end time (scipy's t_bound); a scene still unfinished there
+# is an error, not an outcome. 1e4 Rs/Vs is ten times the longest ordinary scene (a
+# grazing sphere sliding on a plate that barely resists), a second or so of work.
+LONGEST_PHASE = Parameter(
+    "longest_phase",
+    "give up (IntegrationError) when a scene has spent this long, as a multiple of Rs/Vs, "
+    "since contact or its last restart (failure onset, the 180 deg hold)",
+    range=Range(1.0, 1e9),
+    default=1e4,
 )
 
 
@@ -77,6 +86,7 @@ class ScipyIVP(Integrator):
     rtol: float = attrs.evolve(RTOL, default=1e-10).field()
     max_steps: int = MAX_STEPS.field()
     max_seconds: float = MAX_SECONDS.field()
+    longest_phase: float = LONGEST_PHASE.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
         return np.full(dynamics.size, np.nan)  # the solvers choose their own
@@ -108,7 +118,7 @@ class ScipyIVP(Integrator):
             return one.rates(state[:, np.newaxis])[:, 0]
 
         solver_class = getattr(integrate, self.method)
-        bound = float(t[i] + LONGEST_PHASE * one.time_scale[0])
+        bound = float(t[i] + self.longest_phase * one.time_scale[0])
         return solver_class(
             rates, t[i], y[:, i].copy(), bound, rtol=self.rtol, atol=self.rtol * scale
         )
@@ -121,7 +131,9 @@ class ScipyIVP(Integrator):
         for i, solver in enumerate(solvers):
             if solver.status == "finished":
                 raise IntegrationError(
-                    f"solve_ivp: a scene reached no outcome within {LONGEST_PHASE:g} Rs/Vs"
+                    f"solve_ivp: a scene unfinished after longest_phase={self.longest_phase:g} "
+                    "Rs/Vs since its last restart; raise longest_phase "
+                    "(--set integrator.longest_phase=MULTIPLE)"
                 )
             # A trial step far too long (extreme plates) can overshoot to a state whose
             # force overflows; its non-finite error makes scipy reject it and shrink the

@@ -60,7 +60,8 @@ class Archive:
 
     def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
         self.path = Path(path)
-        self.real = Path(os.path.realpath(path)) if os.fspath(path) else self.path
+        self.named = bool(os.fspath(path))  # Path("") is Path("."): keep what was given
+        self.real = Path(os.path.realpath(path)) if self.named else self.path
         # (a name-less path, "" or "/", is refused by every method before the lock is used)
         self.lock_path = self.real.parent / f"{self.real.name or 'root'}.lock"
         self.wait = wait
@@ -72,7 +73,7 @@ class Archive:
         or unwritable directory, a target that is not a regular file, a read-only
         archive, one that is damaged or of another format version."""
         directory = self.real.parent
-        if not os.fspath(self.path) or self.real.is_dir():
+        if not self.named or self.real.is_dir():
             raise ArchiveError(f"archive {self.path!s}: give an archive file name")
         if not directory.is_dir():
             raise ArchiveError(f"archive {self.path}: directory {directory} does not exist")
@@ -146,8 +147,8 @@ class Archive:
 
     @contextlib.contextmanager
     def _open(self) -> Iterator[h5py.File]:
-        if not os.fspath(self.path):
-            raise ArchiveError("give an archive file name")
+        if not self.named:
+            raise ArchiveError("give an archive file name, got ''")
         if not self.real.exists():
             raise ArchiveError(f"archive {self.path} does not exist")
         if not self.real.is_file():
