@@ -203,6 +203,12 @@ def test_a_live_writer_makes_others_wait_or_save_aside_and_readers_read(tmp_path
         assert side.parent == tmp_path and pi.Archive(side).runs() == ["t318/plugging"]
         assert_same(results["plugging"], pi.Archive(side).results("plugging"))
         assert len(pi.Archive(path).runs()) == 2  # the archive itself untouched
+        # A study given such an archive warns per run and still returns its results.
+        with pytest.warns(pi.ArchiveWaitWarning, match="saved to ") as warned:
+            again = study.run(archive=pi.Archive(path, wait=0.0))
+        assert len(warned) == len(study.variants)
+        assert_same(results["plugging"], again["plugging"])
+        assert len(pi.Archive(path).runs()) == 2
     finally:
         holder.stdin.close()
         holder.wait()

@@ -85,6 +85,41 @@ def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stag
     assert set(pi.Archive(path).runs()) == {"w/v", "w/next"} and debris(tmp_path) == []
 
 
+def test_a_failure_letting_go_of_the_lock_keeps_the_run_says_so_and_frees_the_lock(
+    tmp_path, monkeypatch, tiny_result
+):
+    path = tmp_path / "a.h5"
+    make_archive(path)
+
+    def fail(where: str) -> None:
+        if where == "unlock":
+            raise OSError(5, "Input/output error")
+
+    monkeypatch.setattr(appending, "fault_point", fail)
+    study = tiny_study()
+    with pytest.raises(pi.ArchiveError, match="run w/x was added, then letting go of the lock"):
+        pi.Archive(path).append_run(study, pi.Variant("x"), tiny_result, {"note": "x"})
+    monkeypatch.undo()
+    assert set(pi.Archive(path).runs()) == {"w/v", "w/x"} and debris(tmp_path) == []
+    impatient = pi.Archive(path, wait=0.0)  # a lock still held would send this run aside
+    impatient.append_run(study, pi.Variant("y"), tiny_result, {"note": "y"})
+    assert set(pi.Archive(path).runs()) == {"w/v", "w/x", "w/y"}
+
+
+def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_path, tiny_result):
+    path = tmp_path / "a.h5"
+    make_archive(path)
+    done = subprocess.run([sys.executable, "-c", KILLED_APPENDER, str(path), "unlock"])
+    assert done.returncode == -signal.SIGKILL
+    assert set(pi.Archive(path).runs()) == {"w/v", "w/killed"}
+    np.testing.assert_array_equal(
+        pi.Archive(path).results("killed").exit_speed, tiny_result.exit_speed
+    )
+    impatient = pi.Archive(path, wait=0.0)  # the kernel let go of the dead writer's flock
+    impatient.append_run(tiny_study(), pi.Variant("next"), tiny_result, {"note": "x"})
+    assert len(pi.Archive(path).runs()) == 3 and debris(tmp_path) == []
+
+
 RACER = """
 import sys
 import numpy as np

@@ -161,7 +161,7 @@ class Study:
     def run(
         self,
         *,
-        archive: str | Path | None = None,
+        archive: str | Path | Archive | None = None,
         executor: Executor | None = None,
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         record_trajectory: bool = False,
@@ -174,8 +174,10 @@ class Study:
 
         Parameters
         ----------
-        archive : path, optional
+        archive : path or Archive, optional
             HDF5 archive to append each run to as soon as it finishes (docs/archive.md).
+            ``Archive(path, wait=SECONDS)`` sets how long an append waits for another
+            writer (default 300 s) before saving its run to a side archive.
         executor : concurrent.futures.Executor, optional
             Where chunks of ``chunk_size`` scenes run (a process pool, a Dask client's
             ``get_executor()``); the study stays the single writer of the archive.
@@ -193,7 +195,7 @@ class Study:
             Progress bar on stderr; None shows it on a terminal only.
         """
         check_chunk_size(chunk_size)
-        writer = Archive(archive) if archive is not None else None
+        writer = archive if isinstance(archive, Archive) or archive is None else Archive(archive)
         if writer is not None:
             writer.check_writable()
         if resume and writer is None:

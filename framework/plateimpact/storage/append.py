@@ -42,8 +42,9 @@ class StudyDefinition(Protocol):
 
 
 def fault_point(stage: str) -> None:
-    """Called at each stage of an append ("copy", "write", "flush", "fsync", "replace"):
-    nothing, unless a test replaces it to fail or crash there deterministically."""
+    """Called at each stage of an append ("copy", "write", "flush", "fsync", "replace",
+    then "unlock" by the archive, with the run in and the lock still held): nothing,
+    unless a test replaces it to fail or crash there deterministically."""
 
 
 def append(

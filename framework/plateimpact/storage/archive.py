@@ -29,6 +29,7 @@ from ..parameters import Parameter
 from ..ragged import Ragged
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from ..variant import Variant
+from . import append as append_module
 from .append import FORMAT, FORMAT_VERSION, StudyDefinition, append, check_same_scenes
 from .hdf5 import SEAL, digest, plain_attributes
 from .lock import ArchiveBusyError, locked
@@ -103,10 +104,12 @@ class Archive:
         archive longer than ``wait``, the run is saved to a side archive beside it and
         :class:`ArchiveBusyError` says where: a finished run is never lost."""
         self.check_writable()
+        run = None
         try:
             with locked(self.path, self.real, self.lock_path, self.wait):
                 self.check_writable()  # as it is now that we hold it
                 run = append(self.real, study, variant, result, attributes, constants or {})
+                append_module.fault_point("unlock")
         except ArchiveBusyError as exc:
             side = self.real.with_name(
                 f"{self.real.stem}.{study.name}.{variant.name}."
@@ -118,7 +121,13 @@ class Archive:
             ) from None
         except ArchiveError:
             raise
-        except OSError as exc:  # a full disk, a lost mount: the archive is as it was
+        except OSError as exc:
+            if run is not None:  # failed letting go of the lock: the run is in
+                raise ArchiveError(
+                    f"archive {self.path}: run {study.name}/{run} was added, then letting go "
+                    f"of the lock failed: {exc.strerror or exc}"
+                ) from None
+            # a full disk, a lost mount: the archive is as it was
             raise ArchiveError(
                 f"archive {self.path}: cannot add run {study.name}/{variant.name}: "
                 f"{exc.strerror or exc} (the archive is unchanged)"
