@@ -77,12 +77,6 @@ def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> 
         raise OutputError(f"{flag}: directory {directory!r} does not exist")
     if not os.access(directory, os.W_OK | os.X_OK):
         raise OutputError(f"{flag}: directory {directory!r} is not writable")
-    suffixes = SUFFIXES.get(kind)
-    if suffixes is not None and real.suffix.lower() not in suffixes:
-        raise OutputError(
-            f"{flag}: cannot tell the format of {text!r}; end the name with one of "
-            f"{', '.join(suffixes)}"
-        )
     if real.exists() or real.is_symlink():
         try:
             mode = os.stat(real).st_mode
@@ -92,6 +86,12 @@ def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> 
             raise OutputError(f"{flag}: {text!r} is not a regular file; refusing to replace it")
         if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
             raise OutputError(f"{flag}: {text!r} is read-only; refusing to replace it")
+    suffixes = SUFFIXES.get(kind)
+    if suffixes is not None and real.suffix.lower() not in suffixes:
+        raise OutputError(
+            f"{flag}: cannot tell the format of {text!r}; end the name with one of "
+            f"{', '.join(suffixes)}"
+        )
     return real
 
 
