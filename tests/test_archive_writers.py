@@ -168,6 +168,23 @@ def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
     assert link.is_symlink() and debris(tmp_path) == []
 
 
+def test_an_archive_and_an_output_keep_their_owner(tmp_path):
+    if os.geteuid() != 0:
+        pytest.skip("giving a file to another user needs root")
+    path, csv = tmp_path / "a.h5", tmp_path / "s.csv"
+    make_archive(path)
+    csv.write_text("old\n")
+    for owned in (path, csv):
+        os.chown(owned, 65534, 65534)  # nobody's
+    tiny_study().run(archive=path)
+    code, _, err = run_cli(["sweep", "--preset", "2024-T3/3.18", "--speeds", "300",
+                            "--obliquities", "0", "--csv", str(csv)])  # fmt: skip
+    assert code == 0, err
+    for owned in (path, csv):
+        assert (owned.stat().st_uid, owned.stat().st_gid) == (65534, 65534), owned
+    assert len(pi.Archive(path).runs()) == 2 and csv.read_text().startswith("preset,")
+
+
 def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(tmp_path, tiny_result):
     path = tmp_path / "a.h5"
     make_archive(path)
