@@ -106,7 +106,7 @@ _EXPORTS: dict[str, str] = {
     "PluginLoadWarning": "errors",
 }
 #: Submodules users reach as attributes (``pi.units.mm``).
-_SUBMODULES = ("batch", "calibration", "geometry", "presets", "units")
+_SUBMODULES = ("batch", "calibration", "geometry", "limits", "presets", "units")
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 

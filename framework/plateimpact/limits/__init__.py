@@ -1,0 +1,47 @@
+"""Limits and outcome maps: every outcome band of a plate, its boundaries located to a
+tolerance, for any model (docs/limits.md).
+
+>>> limits = along_speed(simulation, sphere, plate, np.radians([0, 45, 60]))
+>>> limits.lines[1].ballistic_limit, limits.lines[1].bands
+"""
+
+from __future__ import annotations
+
+from .find import (
+    MAX_SCAN_SCENES,
+    OBLIQUITY_RANGE,
+    OBLIQUITY_RESOLUTION,
+    OBLIQUITY_TOLERANCE,
+    SPEED_RANGE,
+    SPEED_RESOLUTION,
+    SPEED_TOLERANCE,
+    Limits,
+    along_obliquity,
+    along_speed,
+)
+from .finder import Located, locate
+from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine
+from .regimes import REGIMES, Regime, regime_codes
+
+__all__ = [
+    "MAX_SCAN_SCENES",
+    "OBLIQUITY",
+    "OBLIQUITY_RANGE",
+    "OBLIQUITY_RESOLUTION",
+    "OBLIQUITY_TOLERANCE",
+    "REGIMES",
+    "SPEED",
+    "SPEED_RANGE",
+    "SPEED_RESOLUTION",
+    "SPEED_TOLERANCE",
+    "Band",
+    "Boundary",
+    "LimitLine",
+    "Limits",
+    "Located",
+    "Regime",
+    "along_obliquity",
+    "along_speed",
+    "locate",
+    "regime_codes",
+]

@@ -1,0 +1,228 @@
+"""The limits of a plate: every outcome band along lines of the (speed, obliquity) plane.
+
+``along_speed`` sweeps impact speed at fixed obliquities (ballistic and ricochet
+limits); ``along_obliquity`` sweeps obliquity at fixed speeds (the critical ricochet
+obliquity). Both run any simulation, all lines in one batch per pass (limits.finder).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterable
+from concurrent.futures import Executor
+from typing import Any
+
+import attrs
+import numpy as np
+
+from ..batch import SceneBatch
+from ..bodies import MASS, RADIUS, Plate, Sphere
+from ..errors import ParameterError
+from ..parameters import check_instance
+from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
+from ..storage.plate_file import plate_to_dict
+from ..storage.provenance import versions
+from .finder import SECTIONS, locate
+from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
+from .regimes import Regime, regime_codes
+
+_DEG = math.pi / 180.0
+#: Defaults: boundaries to 0.01 m/s or 0.001 deg; no band of 1 m/s or 0.1 deg missed.
+SPEED_TOLERANCE, SPEED_RESOLUTION = 0.01, 1.0  # [m/s]
+OBLIQUITY_TOLERANCE, OBLIQUITY_RESOLUTION = 0.001 * _DEG, 0.1 * _DEG  # [rad]
+#: The default lines: 50-2000 m/s; 0-89 deg.
+SPEED_RANGE = (50.0, 2000.0)  # [m/s]
+OBLIQUITY_RANGE = (0.0, 89.0 * _DEG)  # [rad]
+#: The scan's largest batch, as a sweep's: more belongs in a study.
+MAX_SCAN_SCENES = 1_000_000
+
+
+@attrs.frozen(eq=False)
+class Limits:
+    """The bands of every line of one request, with what produced them.
+
+    ``axis`` is ``impact_speed`` or ``impact_obliquity``; ``tolerance`` and
+    ``resolution`` are in its SI unit (m/s or rad); ``model`` is the simulation's
+    plug-ins and settings; ``scenes`` how many scenes the finder ran, ``passes`` its
+    refinement passes, ``seconds`` the wall time.
+    """
+
+    axis: str
+    lines: tuple[LimitLine, ...]
+    tolerance: float
+    resolution: float
+    sphere: Sphere
+    plate: Plate
+    model: dict[str, Any]
+    scenes: int
+    passes: int
+    seconds: float
+
+    def to_json(self) -> dict[str, Any]:
+        """One object in user units (``plateimpact limits --json``)."""
+        unit = unit_suffix(self.axis)
+        scale = _DEG if self.axis == OBLIQUITY else 1.0
+        return {
+            "plate": {k: v for k, v in plate_to_dict(self.plate).items() if k != "format"},
+            "sphere": {
+                RADIUS.key: self.sphere.radius / RADIUS.scale,
+                MASS.key: self.sphere.mass / MASS.scale,
+            },
+            "model": self.model,
+            "axis": self.axis,
+            f"tolerance_{unit}": self.tolerance / scale,
+            f"resolution_{unit}": self.resolution / scale,
+            "lines": [line.to_json() for line in self.lines],
+            "scenes": self.scenes,
+            "versions": versions(),
+        }
+
+
+def _floats(name: str, values: Iterable[float] | float) -> np.ndarray:
+    try:
+        array = np.atleast_1d(np.asarray(values, dtype=float)).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError(name, f"{name} must be numbers, got {values!r:.80}") from None
+    if array.size == 0:
+        raise ParameterError(name, f"{name}: give at least one value")
+    return array
+
+
+def _interval(name: str, values: tuple[float, float], declared: Any) -> tuple[float, float]:
+    bounds = _floats(name, values)
+    if bounds.size != 2:
+        raise ParameterError(name, f"{name} must be a range (start, stop), got {values!r:.80}")
+    declared.check(bounds)
+    start, stop = float(bounds[0]), float(bounds[1])
+    if not start < stop:
+        raise ParameterError(
+            name,
+            f"{name}: the range is empty (start {declared.format(start)} must be below "
+            f"stop {declared.format(stop)} {declared.user_unit})",
+        )
+    return start, stop
+
+
+def _steps(
+    tolerance: float, resolution: float, span: float, lines: int, unit: str, scale: float
+) -> None:
+    """Tolerance in (0, span]; resolution in [tolerance, span]; a scan of at most
+    MAX_SCAN_SCENES scenes."""
+    shown = f"{span / scale:.6g} {unit}"
+    if not (math.isfinite(tolerance) and 0.0 < tolerance <= span):
+        raise ParameterError(
+            "tolerance", f"tolerance must be in (0, {shown}] (the range), got {tolerance / scale:g}"
+        )
+    if not (math.isfinite(resolution) and tolerance <= resolution <= span):
+        raise ParameterError(
+            "resolution",
+            f"resolution must be in [{tolerance / scale:g}, {shown}] (from the tolerance to "
+            f"the range), got {resolution / scale:g}",
+        )
+    scan = lines * (math.ceil(span / resolution) + 1)
+    if scan > MAX_SCAN_SCENES:
+        raise ParameterError(
+            "resolution",
+            f"resolution {resolution / scale:g} {unit} over {lines} line(s) of {shown} needs "
+            f"{scan:,} scenes, more than {MAX_SCAN_SCENES:,}: coarsen it or split the range",
+        )
+
+
+def _find(
+    simulation: Simulation,
+    sphere: Sphere,
+    plate: Plate,
+    axis: str,
+    fixed: np.ndarray,
+    span: tuple[float, float],
+    tolerance: float,
+    resolution: float,
+    executor: Executor | None,
+) -> Limits:
+    check_instance("simulation", simulation, Simulation)
+    base = SceneBatch.grid(sphere, plate, [1.0], [0.0])  # checks sphere and plate
+
+    def evaluate(line: np.ndarray, x: np.ndarray) -> np.ndarray:
+        speed, obliquity = (x, fixed[line]) if axis == SPEED else (fixed[line], x)
+        batch = base.take(np.zeros(x.size, dtype=np.int64)).with_columns(
+            impact_speed=speed, impact_obliquity=obliquity
+        )
+        result = simulation.run_batch(batch, executor=executor, chunk_size=DEFAULT_CHUNK_SIZE)
+        return regime_codes(result)
+
+    began = time.perf_counter()
+    starts, ends = np.full(fixed.size, span[0]), np.full(fixed.size, span[1])
+    found = locate(evaluate, starts, ends, resolution, tolerance, SECTIONS)
+    lines = []
+    for i, value in enumerate(fixed):
+        mine = found.line == i
+        boundaries = tuple(
+            Boundary(float(lo), float(hi), Regime.of_code(b), Regime.of_code(a))
+            for lo, hi, b, a in zip(
+                found.low[mine], found.high[mine], found.below[mine], found.above[mine],
+                strict=True,
+            )
+        )  # fmt: skip
+        first = Regime.of_code(int(found.first[i]))
+        lines.append(LimitLine(axis, float(value), span[0], span[1], boundaries, first))
+    return Limits(
+        axis,
+        tuple(lines),
+        tolerance,
+        resolution,
+        sphere,
+        plate,
+        simulation.describe(),
+        found.scenes,
+        found.passes,
+        time.perf_counter() - began,
+    )
+
+
+def along_speed(
+    simulation: Simulation,
+    sphere: Sphere,
+    plate: Plate,
+    obliquities: Iterable[float] | float,
+    speeds: tuple[float, float] = SPEED_RANGE,
+    *,
+    tolerance: float = SPEED_TOLERANCE,
+    resolution: float = SPEED_RESOLUTION,
+    executor: Executor | None = None,
+) -> Limits:
+    """The outcome bands along impact speed at each of ``obliquities`` [rad].
+
+    ``speeds`` is the range (start, stop) [m/s]. Every boundary is bracketed to within
+    ``tolerance`` [m/s], and no band ``resolution`` [m/s] wide or wider is missed
+    (docs/limits.md). ``executor`` (a process pool) spreads the scan over workers.
+    """
+    fixed = _floats("obliquities", obliquities)
+    IMPACT_OBLIQUITY.check(fixed)
+    span = _interval("speeds", speeds, IMPACT_SPEED)
+    _steps(tolerance, resolution, span[1] - span[0], fixed.size, "m/s", 1.0)
+    return _find(simulation, sphere, plate, SPEED, fixed, span, tolerance, resolution, executor)
+
+
+def along_obliquity(
+    simulation: Simulation,
+    sphere: Sphere,
+    plate: Plate,
+    speeds: Iterable[float] | float,
+    obliquities: tuple[float, float] = OBLIQUITY_RANGE,
+    *,
+    tolerance: float = OBLIQUITY_TOLERANCE,
+    resolution: float = OBLIQUITY_RESOLUTION,
+    executor: Executor | None = None,
+) -> Limits:
+    """The outcome bands along impact obliquity at each of ``speeds`` [m/s].
+
+    ``obliquities`` is the range (start, stop) [rad], within [0, π/2); ``tolerance`` and
+    ``resolution`` [rad] as for :func:`along_speed`.
+    """
+    fixed = _floats("speeds", speeds)
+    IMPACT_SPEED.check(fixed)
+    span = _interval("obliquities", obliquities, IMPACT_OBLIQUITY)
+    _steps(tolerance, resolution, span[1] - span[0], fixed.size, "deg", _DEG)
+    return _find(simulation, sphere, plate, OBLIQUITY, fixed, span, tolerance, resolution, executor)
