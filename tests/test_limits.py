@@ -292,3 +292,33 @@ def test_bad_requests_are_parameter_errors_before_any_scene_runs(call, parameter
     with pytest.raises(pi.ParameterError) as info:
         call(simulation, presets.plate("2024-T3/3.18"))
     assert info.value.parameter == parameter
+
+
+# -- the outcome map ----------------------------------------------------------------------
+
+
+def test_the_outcome_map_is_its_scenes_and_its_rows_are_the_limits(simulation):
+    from plateimpact.limits.maps import outcome_map
+
+    plate = presets.plate("2024-T3/3.18")
+    rows = np.radians([0.0, 30.0, 60.0])
+    found = outcome_map(simulation, SPHERE, plate, (100.0, 1000.0), 10, rows)
+    np.testing.assert_allclose(found.speeds, np.linspace(100.0, 1000.0, 10), rtol=1e-15)
+    assert found.shape == (3, 10)
+    for i, j in [(0, 0), (1, 4), (2, 7), (2, 9)]:
+        scene = pi.Scene(SPHERE, plate, found.speeds[j], rows[i])
+        alone = simulation.run(scene)
+        assert found.regime[i, j] == Regime(alone.outcome, alone.plate_failed).code
+        assert found.exit_speed[i, j] == alone.exit_speed  # a scene ignores its batch
+    spacing = found.speeds[1] - found.speeds[0]
+    assert found.limits.resolution == pytest.approx(spacing)
+    for row, line in zip(found.regime, found.limits.lines, strict=True):
+        # each row's regimes are the bands of its line at the grid's speeds
+        for code, speed in zip(row, found.speeds, strict=True):
+            near = any(b.low <= speed <= b.high for b in line.boundaries)
+            band = next(b for b in line.bands if b.start <= speed <= b.end)
+            assert near or band.regime.code == code
+    curves = found.boundary_curves()
+    assert sum(xs.size for _, _, xs, _ in curves) == sum(
+        len(line.boundaries) for line in found.limits.lines
+    )

@@ -21,9 +21,12 @@ from .find import (
 )
 from .finder import Located, locate
 from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine
+from .maps import MAP_OBLIQUITIES, MAP_SPEED_SAMPLES, OutcomeMap, outcome_map
 from .regimes import REGIMES, Regime, regime_codes
 
 __all__ = [
+    "MAP_OBLIQUITIES",
+    "MAP_SPEED_SAMPLES",
     "MAX_SCAN_SCENES",
     "OBLIQUITY",
     "OBLIQUITY_RANGE",
@@ -39,9 +42,11 @@ __all__ = [
     "LimitLine",
     "Limits",
     "Located",
+    "OutcomeMap",
     "Regime",
     "along_obliquity",
     "along_speed",
     "locate",
+    "outcome_map",
     "regime_codes",
 ]

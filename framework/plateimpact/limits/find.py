@@ -20,6 +20,7 @@ from ..batch import SceneBatch
 from ..bodies import MASS, RADIUS, Plate, Sphere
 from ..errors import ParameterError
 from ..parameters import check_instance
+from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
 from ..storage.plate_file import plate_to_dict
@@ -140,7 +141,11 @@ def _find(
     tolerance: float,
     resolution: float,
     executor: Executor | None,
+    scans: list[BatchResult] | None = None,
 ) -> Limits:
+    """The limits along lines ``axis`` at each of ``fixed``; ``scans``, if given, receives
+    the scan's results (the first batch: every line's samples, line-major), which the
+    outcome map draws."""
     check_instance("simulation", simulation, Simulation)
     base = SceneBatch.grid(sphere, plate, [1.0], [0.0])  # checks sphere and plate
 
@@ -150,6 +155,8 @@ def _find(
             impact_speed=speed, impact_obliquity=obliquity
         )
         result = simulation.run_batch(batch, executor=executor, chunk_size=DEFAULT_CHUNK_SIZE)
+        if scans is not None and not scans:
+            scans.append(result)
         return regime_codes(result)
 
     began = time.perf_counter()
