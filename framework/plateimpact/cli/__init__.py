@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from ..errors import ParameterError, PlateImpactError, PluginError
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..storage.provenance import versions
-from . import archive_commands, calibrate, info, scene_commands
+from . import archive_commands, calibrate, info, limits_commands, scene_commands
 from .common import Parser, UsageError
 from .options import flag_of
 from .reporting import one_line_warnings, report_internal_error
@@ -48,6 +48,7 @@ def build_parser(registry: PluginRegistry | None = None) -> argparse.ArgumentPar
     try:
         scene_commands.add_parsers(sub, registry)
         calibrate.add_parsers(sub, registry)
+        limits_commands.add_parsers(sub, registry)
     except argparse.ArgumentError as exc:  # a plug-in's flag is one of the command's own
         raise PluginError(_flag_taken(registry, str(exc).rsplit(": ", 1)[-1])) from None
     archive_commands.add_parsers(sub)

@@ -86,10 +86,18 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
         group.add_argument(flag, dest=_dest(flag), metavar=metavar(declared), help=help_text)
 
 
-def add_body_options(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None:
-    """--preset, --plate-file, --thickness, every declared plate constant, --radius, --mass."""
+def add_body_options(
+    parser: argparse.ArgumentParser, registry: PluginRegistry, *, many_presets: bool = False
+) -> None:
+    """--preset (repeatable if ``many_presets``), --plate-file, --thickness, every declared
+    plate constant, --radius, --mass."""
     group = parser.add_argument_group("plate and sphere (override the preset)")
-    group.add_argument("--preset", help=f"plate preset: {', '.join(presets.PLATES)}")
+    group.add_argument(
+        "--preset",
+        action="append" if many_presets else "store",
+        help=f"plate preset: {', '.join(presets.PLATES)}"
+        + ("; repeatable" if many_presets else ""),
+    )
     group.add_argument(
         "--plate-file",
         metavar="FILE",

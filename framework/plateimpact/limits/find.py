@@ -100,7 +100,7 @@ def _interval(name: str, values: tuple[float, float], declared: Any) -> tuple[fl
     if not start < stop:
         raise ParameterError(
             name,
-            f"{name}: the range is empty (start {declared.format(start)} must be below "
+            f"the range is empty (start {declared.format(start)} must be below "
             f"stop {declared.format(stop)} {declared.user_unit})",
         )
     return start, stop
@@ -127,7 +127,8 @@ def _steps(
         raise ParameterError(
             "resolution",
             f"resolution {resolution / scale:g} {unit} over {lines} line(s) of {shown} needs "
-            f"{scan:,} scenes, more than {MAX_SCAN_SCENES:,}: coarsen it or split the range",
+            f"{scan:,} scenes, more than {MAX_SCAN_SCENES:,}: coarsen it, or ask for fewer "
+            "lines or a shorter range",
         )
 
 

@@ -24,7 +24,9 @@ def _user(axis: str, value: float | None) -> float | None:
     """``value`` [SI] on ``axis`` in user units (m/s or degrees); None stays None."""
     if value is None:
         return None
-    return float(value) / _DEG if axis == OBLIQUITY else float(value)
+    if axis == OBLIQUITY:  # 15, not 14.999999999999998 after the round trip through rad
+        return float(f"{float(value) / _DEG:.12g}")
+    return float(value)
 
 
 def unit_suffix(axis: str) -> str:
