@@ -6,6 +6,7 @@ import argparse
 import copy
 import json
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -147,18 +148,15 @@ def limits_command(args: argparse.Namespace) -> None:
     if along_speed:
         lines = _values(args.obliquities, "--obliquities", "deg") * _DEG
         span = lim.SPEED_RANGE if args.speeds is None else _range(args.speeds, "--speeds")
-        found = lim.along_speed(
-            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution
-        )
+        find: Callable[..., lim.Limits] = lim.along_speed
     else:
         lines = _values(args.speeds, "--speeds", "m/s")
         span = lim.OBLIQUITY_RANGE
         if args.obliquities is not None:
             start, stop = _range(args.obliquities, "--obliquities")
             span = (start * _DEG, stop * _DEG)
-        found = lim.along_obliquity(
-            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution
-        )
+        find = lim.along_obliquity
+    found = find(simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution)
     if args.csv is not None:
         write_atomically(args.csv, _csv(found), "--csv")
     if args.png is not None:
@@ -233,16 +231,18 @@ def map_command(args: argparse.Namespace) -> None:
         raise UsageError("--preset: an outcome map draws at most 4 plates (one panel each)")
     choice = model_choice(args)
     simulation = choice.simulation()
-    maps = []
+    plates = []
     for preset in presets_given:
         one = copy.copy(args)
         one.preset = preset
-        sphere, plate, label = bodies(one, choice, simulation.model)
+        plates.append(bodies(one, choice, simulation.model))
+    maps = []
+    for sphere, plate, label in plates:
         found = lim.outcome_map(simulation, sphere, plate, span, samples, rows, tolerance=tolerance)
         maps.append((label, found))
         print(
-            f"{label}: {found.shape[0]} x {found.shape[1]} map, {found.limits.scenes:,} scenes "
-            f"in {found.limits.seconds:.1f} s"
+            f"{label}: {found.shape[0]} x {found.shape[1]} map, "
+            f"{found.limits.scenes:,} scenes in {found.limits.seconds:.1f} s"
         )
     from ..limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
