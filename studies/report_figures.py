@@ -8,6 +8,9 @@
 * fig35_craters_6061T6_9.53mm_60deg.png: predicted crater sections for the 9.53-mm
   plate at 60° and 0.263 and 0.737 km/s (the speeds of Figure 35).
 * hinge_geometry.png: the hinge (finger) failure model at three moments of one impact.
+* outcome_map_2024T3_3.18mm.png: the outcome map of the 3.18-mm plate (200 x 86 grid,
+  boundaries to 0.01 m/s), and limit_curves.png: ballistic and ricochet limits of the
+  five plates against obliquity (docs/limits.md).
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import attrs
 import numpy as np
 
 import plateimpact as pi
-from plateimpact import plotting, presets
+from plateimpact import limits, plotting, presets
 from plateimpact.crater import crater_section
 from plateimpact.units import deg, mm
 from plateimpact_plugins import Hinge
@@ -159,12 +162,35 @@ def hinge_geometry(out: Path) -> Path:
     return path
 
 
+def outcome_map(out: Path) -> Path:
+    from plateimpact.limits.figures import plot_outcome_map  # noqa: PLC0415
+
+    plate = presets.plate("2024-T3/3.18")
+    found = limits.outcome_map(pi.Simulation.from_names(), SPHERE, plate)
+    path = out / "outcome_map_2024T3_3.18mm.png"
+    plotting.save(plot_outcome_map([("2024-T3, 3.18 mm", found)]), str(path))
+    return path
+
+
+def limit_curves(out: Path) -> Path:
+    from plateimpact.limits.figures import plot_limit_curves  # noqa: PLC0415
+
+    simulation = pi.Simulation.from_names()
+    maps = [
+        (name, limits.outcome_map(simulation, SPHERE, presets.plate(name)))
+        for name in presets.PLATES
+    ]
+    path = out / "limit_curves.png"
+    plotting.save(plot_limit_curves(maps), str(path))
+    return path
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("docs/figures"))
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    for make in (figure_30_31, figure_35, hinge_geometry):
+    for make in (figure_30_31, figure_35, hinge_geometry, outcome_map, limit_curves):
         print(make(args.out))
 
 
