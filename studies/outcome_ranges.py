@@ -3,33 +3,35 @@ embeds or perforates, by obliquity (the ranges the 1976 computation had to find 
 
 Run:  python studies/outcome_ranges.py [--integrator dopri5|segment|solve_ivp]
 
-Prints, per plate and obliquity, the impact-speed ranges [m/s] of each outcome on a
-25 m/s grid, marking ricochets after plate failure (the thin-plate band) with "*".
+Prints, per plate and obliquity, the impact-speed range [m/s] of each outcome band over
+25-1500 m/s, each boundary located to 0.01 m/s and no band of 1 m/s missed
+(plateimpact.limits, docs/limits.md), marking the bands after plate failure with "*"
+(R*: the thin-plate band, a ricochet off a plate that failed).
 """
 
 from __future__ import annotations
 
 import argparse
-import itertools
 import time
 
 import numpy as np
 
 import plateimpact as pi
-from plateimpact import presets
+from plateimpact import limits, presets
 
-SPEEDS = np.arange(25.0, 1501.0, 25.0)  # [m/s]
+SPEEDS = (25.0, 1500.0)  # [m/s]
 OBLIQUITIES = (0.0, 20.0, 30.0, 45.0, 60.0)  # [deg]
+SHORT = {"ricochet": "R", "embedment": "E", "perforation": "P"}
 
 
-def ranges(outcome: np.ndarray, failed: np.ndarray) -> str:
-    """'R 25–300 | R* 325–350 | E 375–500 | P 525–1500' from per-speed outcomes."""
-    codes = np.where((outcome == pi.Outcome.RICOCHET) & failed, 0, outcome)
-    labels = {0: "R*", 1: "R", 2: "E", 3: "P"}
+def ranges(line: limits.LimitLine) -> str:
+    """'R 25.00–300.12 | R* 300.12–351.40 | E* 351.40–353.02 | P 353.02–1500.00'."""
     parts = []
-    for code, run in itertools.groupby(zip(codes, SPEEDS, strict=True), key=lambda cv: cv[0]):
-        run = [v for _, v in run]
-        parts.append(f"{labels[int(code)]} {run[0]:.0f}–{run[-1]:.0f}")
+    for band in line.bands:
+        mark = (
+            "*" if band.regime.plate_failed and band.regime.outcome.label != "perforation" else ""
+        )
+        parts.append(f"{SHORT[band.regime.outcome.label]}{mark} {band.start:.2f}–{band.end:.2f}")
     return " | ".join(parts)
 
 
@@ -39,23 +41,18 @@ def main() -> None:
     args = parser.parse_args()
 
     simulation = pi.Simulation.from_names(integrator=args.integrator)
-    cases = list(itertools.product(presets.PLATES, OBLIQUITIES))
-    batch = pi.SceneBatch.concat(
-        pi.SceneBatch.grid(presets.DEFAULT_SPHERE, presets.plate(name), SPEEDS, [np.radians(ob)])
-        for name, ob in cases
-    )
-    start = time.perf_counter()
-    result = simulation.run_batch(batch)
-    elapsed = time.perf_counter() - start
-
-    n = SPEEDS.size
-    for k, (name, obliquity) in enumerate(cases):
-        part = slice(k * n, (k + 1) * n)
-        outcome_ranges = ranges(result.outcome[part], result.plate_failed[part])
-        print(f"{name:14s} {obliquity:4.0f}°  {outcome_ranges}")
+    start, scenes = time.perf_counter(), 0
+    for name in presets.PLATES:
+        found = limits.along_speed(
+            simulation, presets.DEFAULT_SPHERE, presets.plate(name), np.radians(OBLIQUITIES),
+            SPEEDS,
+        )  # fmt: skip
+        scenes += found.scenes
+        for obliquity, line in zip(OBLIQUITIES, found.lines, strict=True):
+            print(f"{name:14s} {obliquity:4.0f}°  {ranges(line)}")
     print(
-        f"\n{batch.size} scenes in {elapsed:.1f} s ({simulation.integrator.name} "
-        f"{simulation.integrator.settings()}); R* = ricochet after plate failure"
+        f"\n{scenes} scenes in {time.perf_counter() - start:.1f} s ({simulation.integrator.name} "
+        f"{simulation.integrator.settings()}); * = after plate failure"
     )
 
 
