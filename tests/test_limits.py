@@ -322,3 +322,18 @@ def test_the_outcome_map_is_its_scenes_and_its_rows_are_the_limits(simulation):
     assert sum(xs.size for _, _, xs, _ in curves) == sum(
         len(line.boundaries) for line in found.limits.lines
     )
+
+
+def test_maps_found_together_are_the_maps_found_alone(simulation):
+    from plateimpact.limits.maps import outcome_map, outcome_maps
+
+    names = ["2024-T3/1.27", "SAE1010/1.47"]
+    grid = ((100.0, 900.0), 9, np.radians([0.0, 40.0]))
+    together = outcome_maps(simulation, SPHERE, [presets.plate(n) for n in names], *grid)
+    for name, found in zip(names, together, strict=True):
+        alone = outcome_map(simulation, SPHERE, presets.plate(name), *grid)
+        np.testing.assert_array_equal(found.regime, alone.regime)
+        np.testing.assert_array_equal(found.exit_speed, alone.exit_speed)
+        assert found.limits.plate == presets.plate(name)
+        for a, b in zip(found.limits.lines, alone.limits.lines, strict=True):
+            assert a.boundaries == b.boundaries

@@ -236,14 +236,15 @@ def map_command(args: argparse.Namespace) -> None:
         one = copy.copy(args)
         one.preset = preset
         plates.append(bodies(one, choice, simulation.model))
-    maps = []
-    for sphere, plate, label in plates:
-        found = lim.outcome_map(simulation, sphere, plate, span, samples, rows, tolerance=tolerance)
-        maps.append((label, found))
-        print(
-            f"{label}: {found.shape[0]} x {found.shape[1]} map, "
-            f"{found.limits.scenes:,} scenes in {found.limits.seconds:.1f} s"
-        )
+    spheres = {sphere for sphere, _, _ in plates}  # one, from --radius and --mass
+    found = lim.outcome_maps(simulation, spheres.pop(), [plate for _, plate, _ in plates], span,
+                             samples, rows, tolerance=tolerance)  # fmt: skip
+    maps = [(label, one) for (_, _, label), one in zip(plates, found, strict=True)]
+    shape, counted = found[0].shape, found[0].limits
+    print(
+        f"{', '.join(label for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
+        f"{shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
+    )
     from ..limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves

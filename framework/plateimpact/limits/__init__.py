@@ -21,7 +21,7 @@ from .find import (
 )
 from .finder import Located, locate
 from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine
-from .maps import MAP_OBLIQUITIES, MAP_SPEED_SAMPLES, OutcomeMap, outcome_map
+from .maps import MAP_OBLIQUITIES, MAP_SPEED_SAMPLES, OutcomeMap, outcome_map, outcome_maps
 from .regimes import REGIMES, Regime, regime_codes
 
 __all__ = [
@@ -48,5 +48,6 @@ __all__ = [
     "along_speed",
     "locate",
     "outcome_map",
+    "outcome_maps",
     "regime_codes",
 ]

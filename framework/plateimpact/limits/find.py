@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from concurrent.futures import Executor
 from typing import Any
 
@@ -47,7 +47,8 @@ class Limits:
     ``axis`` is ``impact_speed`` or ``impact_obliquity``; ``tolerance`` and
     ``resolution`` are in its SI unit (m/s or rad); ``model`` is the simulation's
     plug-ins and settings; ``scenes`` how many scenes the finder ran, ``passes`` its
-    refinement passes, ``seconds`` the wall time.
+    refinement passes, ``seconds`` the wall time (for plates found together, the
+    request's: see :func:`~plateimpact.limits.outcome_maps`).
     """
 
     axis: str
@@ -135,7 +136,7 @@ def _steps(
 def _find(
     simulation: Simulation,
     sphere: Sphere,
-    plate: Plate,
+    plates: Sequence[Plate],
     axis: str,
     fixed: np.ndarray,
     span: tuple[float, float],
@@ -143,16 +144,21 @@ def _find(
     resolution: float,
     executor: Executor | None,
     scans: list[BatchResult] | None = None,
-) -> Limits:
-    """The limits along lines ``axis`` at each of ``fixed``; ``scans``, if given, receives
-    the scan's results (the first batch: every line's samples, line-major), which the
-    outcome map draws."""
+) -> list[Limits]:
+    """The limits of each of ``plates`` along lines ``axis`` at each of ``fixed``, all
+    plates' lines in the same batches (so they share the refinement passes, which cost
+    more than their scenes). ``scans``, if given, receives the scan's results (the first
+    batch: every line's samples, plate-major, then line-major), which maps draw."""
     check_instance("simulation", simulation, Simulation)
-    base = SceneBatch.grid(sphere, plate, [1.0], [0.0])  # checks sphere and plate
+    # one scene per plate (which checks sphere and plates); the plates must declare the
+    # same constants to share a batch
+    base = SceneBatch.concat([SceneBatch.grid(sphere, plate, [1.0], [0.0]) for plate in plates])
+    plate_of_line = np.repeat(np.arange(len(plates)), fixed.size)
+    fixed_of_line = np.tile(fixed, len(plates))
 
     def evaluate(line: np.ndarray, x: np.ndarray) -> np.ndarray:
-        speed, obliquity = (x, fixed[line]) if axis == SPEED else (fixed[line], x)
-        batch = base.take(np.zeros(x.size, dtype=np.int64)).with_columns(
+        speed, obliquity = (x, fixed_of_line[line]) if axis == SPEED else (fixed_of_line[line], x)
+        batch = base.take(plate_of_line[line]).with_columns(
             impact_speed=speed, impact_obliquity=obliquity
         )
         result = simulation.run_batch(batch, executor=executor, chunk_size=DEFAULT_CHUNK_SIZE)
@@ -161,10 +167,11 @@ def _find(
         return regime_codes(result)
 
     began = time.perf_counter()
-    starts, ends = np.full(fixed.size, span[0]), np.full(fixed.size, span[1])
+    starts, ends = np.full(fixed_of_line.size, span[0]), np.full(fixed_of_line.size, span[1])
     found = locate(evaluate, starts, ends, resolution, tolerance, SECTIONS)
+    seconds = time.perf_counter() - began
     lines = []
-    for i, value in enumerate(fixed):
+    for i, value in enumerate(fixed_of_line):
         mine = found.line == i
         boundaries = tuple(
             Boundary(float(lo), float(hi), Regime.of_code(b), Regime.of_code(a))
@@ -175,18 +182,23 @@ def _find(
         )  # fmt: skip
         first = Regime.of_code(int(found.first[i]))
         lines.append(LimitLine(axis, float(value), span[0], span[1], boundaries, first))
-    return Limits(
-        axis,
-        tuple(lines),
-        tolerance,
-        resolution,
-        sphere,
-        plate,
-        simulation.describe(),
-        found.scenes,
-        found.passes,
-        time.perf_counter() - began,
-    )
+    model = simulation.describe()
+    n = fixed.size
+    return [
+        Limits(
+            axis,
+            tuple(lines[k * n : (k + 1) * n]),
+            tolerance,
+            resolution,
+            sphere,
+            plate,
+            model,
+            found.scenes,
+            found.passes,
+            seconds,
+        )  # fmt: skip
+        for k, plate in enumerate(plates)
+    ]
 
 
 def along_speed(
@@ -210,7 +222,10 @@ def along_speed(
     IMPACT_OBLIQUITY.check(fixed)
     span = _interval("speeds", speeds, IMPACT_SPEED)
     _steps(tolerance, resolution, span[1] - span[0], fixed.size, "m/s", 1.0)
-    return _find(simulation, sphere, plate, SPEED, fixed, span, tolerance, resolution, executor)
+    (found,) = _find(
+        simulation, sphere, [plate], SPEED, fixed, span, tolerance, resolution, executor
+    )
+    return found
 
 
 def along_obliquity(
@@ -233,4 +248,7 @@ def along_obliquity(
     IMPACT_SPEED.check(fixed)
     span = _interval("obliquities", obliquities, IMPACT_OBLIQUITY)
     _steps(tolerance, resolution, span[1] - span[0], fixed.size, "deg", _DEG)
-    return _find(simulation, sphere, plate, OBLIQUITY, fixed, span, tolerance, resolution, executor)
+    (found,) = _find(
+        simulation, sphere, [plate], OBLIQUITY, fixed, span, tolerance, resolution, executor
+    )
+    return found

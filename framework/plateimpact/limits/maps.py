@@ -10,7 +10,7 @@ missing from a row (``plateimpact limits`` finds every band of 1 m/s).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from concurrent.futures import Executor
 
 import attrs
@@ -18,6 +18,7 @@ import numpy as np
 
 from ..bodies import Plate, Sphere
 from ..errors import ParameterError
+from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
@@ -103,6 +104,29 @@ def outcome_map(
     """The outcome map of ``plate`` over ``speed_samples`` equally spaced speeds in
     ``speeds`` (start, stop) [m/s] and each of ``obliquities`` [rad]; boundaries to
     ``tolerance`` [m/s]."""
+    check_instance("plate", plate, Plate)
+    (found,) = outcome_maps(
+        simulation, sphere, [plate], speeds, speed_samples, obliquities,
+        tolerance=tolerance, executor=executor,
+    )  # fmt: skip
+    return found
+
+
+def outcome_maps(
+    simulation: Simulation,
+    sphere: Sphere,
+    plates: Sequence[Plate],
+    speeds: tuple[float, float] = SPEED_RANGE,
+    speed_samples: int = MAP_SPEED_SAMPLES,
+    obliquities: Iterable[float] = MAP_OBLIQUITIES,
+    *,
+    tolerance: float = SPEED_TOLERANCE,
+    executor: Executor | None = None,
+) -> list[OutcomeMap]:
+    """The outcome maps of several plates on one grid, found together: their rows share
+    the batches, and so the refinement passes, which cost more than their scenes (five
+    plates take about three times as long as one). The plates must declare the same
+    constants."""
     rows = _floats("obliquities", obliquities)
     IMPACT_OBLIQUITY.check(rows)
     if not np.all(np.diff(rows) > 0):
@@ -112,11 +136,13 @@ def outcome_map(
         raise ParameterError(
             "speed_samples", f"a map needs at least 2 speeds, got {speed_samples!r}"
         )
-    if rows.size * speed_samples > MAX_MAP_SCENES:
+    plates = list(plates)
+    scenes = len(plates) * rows.size * speed_samples
+    if not plates or scenes > MAX_MAP_SCENES:
         raise ParameterError(
             "speed_samples",
-            f"a map of {rows.size} x {speed_samples} = {rows.size * speed_samples:,} scenes "
-            f"is more than {MAX_MAP_SCENES:,}",
+            f"{len(plates)} map(s) of {rows.size} x {speed_samples} make {scenes:,} scenes; "
+            f"give at least one plate and at most {MAX_MAP_SCENES:,} scenes",
         )
     resolution = (span[1] - span[0]) / (speed_samples - 1)
     _steps(min(tolerance, resolution), resolution, span[1] - span[0], rows.size, "m/s", 1.0)
@@ -126,18 +152,24 @@ def outcome_map(
             f"tolerance must be in (0, {resolution:g}] m/s (the map's spacing), got {tolerance:g}",
         )
     scans: list[BatchResult] = []
-    limits = _find(
-        simulation, sphere, plate, SPEED, rows, span, tolerance, resolution, executor, scans
+    found = _find(
+        simulation, sphere, plates, SPEED, rows, span, tolerance, resolution, executor, scans
     )
     (scan,) = scans
-    line, k, x = scan_points(np.full(rows.size, span[0]), np.full(rows.size, span[1]), resolution)
-    shape = (rows.size, speed_samples)
+    _, _, x = scan_points(np.full(rows.size, span[0]), np.full(rows.size, span[1]), resolution)
     assert x.size == rows.size * speed_samples  # the scan is the grid, row by row
-    return OutcomeMap(
-        speeds=x[:speed_samples].copy(),
-        obliquities=rows,
-        regime=regime_codes(scan).reshape(shape),
-        exit_speed=np.asarray(scan.exit_speed).reshape(shape),
-        exit_obliquity=np.asarray(scan.exit_obliquity).reshape(shape),
-        limits=limits,
-    )
+    shape = (len(plates), rows.size, speed_samples)
+    regime = regime_codes(scan).reshape(shape)
+    exit_speed = np.asarray(scan.exit_speed).reshape(shape)
+    exit_obliquity = np.asarray(scan.exit_obliquity).reshape(shape)
+    return [
+        OutcomeMap(
+            speeds=x[:speed_samples].copy(),
+            obliquities=rows,
+            regime=regime[k],
+            exit_speed=exit_speed[k],
+            exit_obliquity=exit_obliquity[k],
+            limits=limits,
+        )
+        for k, limits in enumerate(found)
+    ]
