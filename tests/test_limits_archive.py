@@ -1,10 +1,11 @@
 """Limits and outcome maps in study archives: stored, read back as written, sealed,
-readable without plateimpact, appended atomically, compared (docs/archive.md)."""
+readable without plateimpact, appended atomically, shown and compared (docs/archive.md)."""
 
 from __future__ import annotations
 
 import json
 import math
+import re
 
 import attrs
 import h5py
@@ -12,6 +13,7 @@ import numpy as np
 import pytest
 from test_archive import flip_bytes
 from test_archive_writers import STAGES, debris
+from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
@@ -170,6 +172,8 @@ def test_damaged_attributes_are_an_archive_error(tmp_path, plugging, damage, mes
         damage(f["limits/plugging"])
     with pytest.raises(pi.ArchiveError, match=message):
         limits.read_limits(path, "plugging")
+    code, _, err = run_cli(["show", str(path)])
+    assert_one_line(code, err, message)
 
 
 def test_damaged_data_is_an_archive_error(tmp_path, plugging):
@@ -305,3 +309,123 @@ def test_compare_limits_pairs_boundaries_by_regimes_and_reports_bands_in_one_onl
     assert [s.shift for s in comparison.lines[0].boundaries] == pytest.approx([1.0] * 3)
     with pytest.raises(pi.ParameterError, match="cannot be compared"):
         limits.compare_limits(plugging, attrs.evolve(plugging, axis=limits.OBLIQUITY))
+
+
+# -- show and compare ------------------------------------------------------------------------
+
+
+def numbers_after(text: str, words: str) -> list[float]:
+    return [float(x) for x in re.findall(re.escape(words) + r" ([-+]?[\d.]+)", text)]
+
+
+def test_show_lists_limits_and_maps_and_leaves_the_runs_as_they_were(
+    tmp_path, plugging, by_obliquity, outcome_map
+):
+    path = tmp_path / "a.h5"
+    tiny_study().run(archive=path)
+    code, runs_only, _ = run_cli(["show", str(path)])
+    assert code == 0
+    limits.archive_limits(path, "plugging", plugging)
+    limits.archive_limits(path, "critical", by_obliquity)
+    limits.archive_limits(path, "map", outcome_map)
+    code, out, err = run_cli(["show", str(path)])
+    assert code == 0, err
+    assert out.startswith(runs_only)  # the runs' listing unchanged, the limits after it
+    shown = out[len(runs_only) :]
+    assert "limits/plugging: limits along impact speed, 2 line(s)" in shown
+    assert "limits/critical: limits along impact obliquity, 1 line(s)" in shown
+    assert "limits/map: outcome map, 3 obliquities x 10 speeds (0-60 deg, 100-1000 m/s)" in shown
+    assert "plate 2024-T3 3.18 mm" in shown and "poncelet + plugging" in shown
+    assert "tolerance 0.01 m/s, resolution 10 m/s" in shown
+    assert "tolerance 0.001 deg, resolution 1 deg" in shown
+    lines = (*plugging.lines, *outcome_map.limits.lines)  # the map: one line per row
+    for named in ("ballistic limit", "ricochet limit"):
+        expected = [x for x in (getattr(line, named.replace(" ", "_")) for line in lines) if x]
+        assert len(expected) >= 2, named
+        shown_values = numbers_after(shown, named)
+        assert shown_values == pytest.approx(expected, abs=plugging.tolerance / 2), named
+    assert shown.count("ricochet limit none") == 5 - len(numbers_after(shown, "ricochet limit"))
+    critical = numbers_after(shown, "critical ricochet obliquity")
+    assert critical == pytest.approx(
+        [math.degrees(by_obliquity.lines[0].critical_ricochet_obliquity)], abs=5e-4
+    )
+
+
+def expected_shifts(a: limits.LimitLine, b: limits.LimitLine) -> list[tuple[str, str, float]]:
+    """The k-th boundary of each (below, above) pair in A with the k-th in B."""
+    pairs = []
+    for pair in {(x.below, x.above) for x in a.boundaries}:
+        mine = [x for x in a.boundaries if (x.below, x.above) == pair]
+        theirs = [y for y in b.boundaries if (y.below, y.above) == pair]
+        pairs += [
+            (x.below.label, x.above.label, y.at - x.at) for x, y in zip(mine, theirs, strict=True)
+        ]
+    return sorted(pairs)
+
+
+def test_compare_says_how_far_each_boundary_moved(tmp_path, plugging, hinge):
+    path = tmp_path / "a.h5"
+    limits.archive_limits(path, "plugging", plugging)
+    limits.archive_limits(path, "hinge", hinge)
+    code, out, err = run_cli(["compare", str(path), "plugging", "limits/hinge", "--json"])
+    assert code == 0, err
+    found = json.loads(out)
+    assert [line["obliquity_deg"] for line in found["lines"]] == pytest.approx([0.0, 45.0])
+    for line, a, b in zip(found["lines"], plugging.lines, hinge.lines, strict=True):
+        shifts = sorted((s["below"], s["above"], s["shift_m_s"]) for s in line["boundaries"])
+        assert shifts == expected_shifts(a, b)
+        assert len(shifts) == len(a.boundaries) == len(b.boundaries)
+    moved = [s["shift_m_s"] for line in found["lines"] for s in line["boundaries"]]
+    assert max(moved) > 10.0  # a hinge holds longer than a plug: the ballistic limit rises
+    code, text, err = run_cli(["compare", str(path), "plugging", "hinge"])
+    assert code == 0, err
+    rows = [row for row in text.splitlines() if "; shift " in row]
+    assert len(rows) == sum(len(line.boundaries) for line in plugging.lines)
+    line_45 = [row for row in rows if row.startswith("  obliquity 45 deg: embedment after")]
+    shift = hinge.lines[1].ballistic_limit - plugging.lines[1].ballistic_limit
+    assert numbers_after(line_45[0], "shift") == pytest.approx([shift], abs=1e-3)
+
+
+def test_compare_reports_lines_in_one_only(tmp_path, plugging, outcome_map):
+    path = tmp_path / "a.h5"
+    limits.archive_limits(path, "plugging", plugging)
+    limits.archive_limits(path, "map", outcome_map)
+    code, out, err = run_cli(["compare", str(path), "plugging", "map", "--json"])
+    assert code == 0, err
+    found = json.loads(out)
+    assert [line["obliquity_deg"] for line in found["lines"]] == [0.0]
+    assert found["lines_only_in_a_deg"] == pytest.approx([45.0])
+    assert found["lines_only_in_b_deg"] == pytest.approx([30.0, 60.0])
+    code, text, err = run_cli(["compare", str(path), "plugging", "map"])
+    assert code == 0, err
+    assert "obliquity 45 deg: the line is only in plugging" in text
+    assert "obliquity 30 deg: the line is only in map" in text
+
+
+def test_bad_show_and_compare_use_is_one_line(tmp_path, plugging, by_obliquity):
+    path = tmp_path / "a.h5"
+    tiny_study().run(archive=path)
+    limits.archive_limits(path, "plugging", plugging)
+    limits.archive_limits(path, "critical", by_obliquity)
+    png = str(tmp_path / "c.png")
+    for argv, words in [
+        (["compare", str(path), "plugging", "v"], ("'v' is a run", "'plugging' is stored limits")),
+        (["compare", str(path), "v", "limits/plugging"], ("is a run",)),
+        (["compare", str(path), "plugging", "nope"], ("no run 'nope'", "limits/plugging", "w/v")),
+        (["compare", str(path), "plugging", "critical"], ("along the same axis",)),
+        (["compare", str(path), "plugging", "plugging", "--png", png], ("--png draws runs",)),
+    ]:
+        code, out, err = run_cli(argv)
+        assert_one_line(code, err, *words)
+        assert out == ""
+
+
+def test_compare_json_of_two_runs_is_their_summary(tmp_path):
+    path = tmp_path / "a.h5"
+    study = pi.Study.grid("w", [PLATE], [0, 45], np.array([300.0, 900.0]),
+                          [pi.Variant("v"), pi.Variant("intact", failure="intact")])  # fmt: skip
+    results = study.run(archive=path)
+    code, out, err = run_cli(["compare", str(path), "v", "intact", "--json"])
+    assert code == 0, err
+    expected = {"a": "w/v", "b": "w/intact", **results.compare("v", "intact").summary()}
+    assert json.loads(out) == expected and expected["outcome_changes"] > 0
