@@ -227,7 +227,7 @@ class Archive:
     def _read(self, f: h5py.File, path: str) -> np.ndarray:
         try:
             return np.asarray(f[path][()])
-        except (OSError, KeyError, ValueError) as exc:
+        except (OSError, KeyError, ValueError, MemoryError) as exc:  # memory: a damaged shape
             raise ArchiveError(
                 f"archive {self.path}: {path} cannot be read ({_first_line(exc)}); "
                 "the file is damaged"
