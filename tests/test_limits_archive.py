@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import math
 import re
+import subprocess
+import sys
 
 import attrs
 import h5py
@@ -182,6 +184,36 @@ def test_damaged_data_is_an_archive_error(tmp_path, plugging):
     flip_bytes(path, "limits/plugging/boundaries/low")
     with pytest.raises(pi.ArchiveError, match="damaged"):
         limits.read_limits(path, "plugging")
+
+
+CRASHES_HDF5 = b"long_name\x00\x00\x00\x00\x00\x00\x00\x19\x01"
+
+
+def test_a_dataset_attribute_that_crashes_hdf5_is_never_read(tmp_path, plugging):
+    """Found by fuzzing ``show``: a flipped bit in the datatype of a dataset's
+    ``long_name`` (a variable-length kind that does not exist) makes libhdf5 crash when
+    the attribute is read. Reading a record reads no dataset attributes (they are for
+    readers without plateimpact); the data, checksummed, reads back whole. Run in
+    subprocesses, so that a crash fails the test instead of ending pytest."""
+    path = tmp_path / "a.h5"
+    limits.archive_limits(path, "plugging", plugging)
+    data = path.read_bytes()
+    assert data.count(CRASHES_HDF5) > 10  # every dataset's long_name, as h5py lays it out
+    path.write_bytes(data.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05"))
+    plain = (
+        "import h5py, sys; "
+        "h5py.File(sys.argv[1])['limits/plugging/sphere/radius'].attrs['long_name']"
+    )
+    assert subprocess.run([sys.executable, "-c", plain, str(path)]).returncode != 0
+    ours = (
+        "import sys; from plateimpact import limits; from plateimpact.cli import main; "
+        "print(limits.read_limits(sys.argv[1], 'plugging').lines[1].ballistic_limit); "
+        "sys.exit(main(['show', sys.argv[1]]))"
+    )
+    done = subprocess.run([sys.executable, "-c", ours, str(path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert float(done.stdout.splitlines()[0]) == plugging.lines[1].ballistic_limit
+    assert "limits/plugging: limits along impact speed" in done.stdout
 
 
 # -- reviewed without plateimpact ------------------------------------------------------------
