@@ -15,6 +15,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import plateimpact as pi
+from plateimpact import limits, presets
 from plateimpact.cli import main as cli
 
 VALUES = st.sampled_from(
@@ -105,6 +106,36 @@ def test_bit_flipped_archives_give_one_line_errors(archive_bytes, flips):
     for where, mask in flips:
         data[min(int(where * len(data)), len(data) - 1)] ^= mask
     check_archive(bytes(data))
+
+
+@pytest.fixture(scope="module")
+def limits_archive_bytes(archive_bytes) -> bytes:
+    """The archive of ``archive_bytes`` with stored limits beside its study."""
+    with tempfile.TemporaryDirectory() as directory:
+        path = Path(directory) / "a.h5"
+        path.write_bytes(archive_bytes)
+        found = limits.along_speed(
+            pi.Simulation.from_names(), presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18"),
+            [0.0, 0.5], (100.0, 900.0), resolution=50.0,
+        )  # fmt: skip
+        limits.archive_limits(path, "l", found)
+        return ArchiveBytes(path.read_bytes())
+
+
+@given(flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=8))
+def test_bit_flipped_archives_with_limits_give_one_line_errors(limits_archive_bytes, flips):
+    data = bytearray(limits_archive_bytes)
+    for where, mask in flips:
+        data[min(int(where * len(data)), len(data) - 1)] ^= mask
+    with tempfile.TemporaryDirectory() as directory:
+        path = Path(directory) / "damaged.h5"
+        path.write_bytes(bytes(data))
+        for argv in (["show"], ["compare", "l", "l"], ["compare", "l", "l", "--json"]):
+            assert_clean(*run_cli([argv[0], str(path), *argv[1:]]))
+        try:  # the Python API raises ArchiveError (or reads the limits back whole)
+            assert len(limits.read_limits(path, "l").lines) == 2
+        except (pi.ArchiveError, pi.errors.UnknownNameError):
+            pass
 
 
 def test_a_refused_run_writes_nothing(tmp_path):

@@ -197,7 +197,7 @@ class Study:
         check_chunk_size(chunk_size)
         writer = archive if isinstance(archive, Archive) or archive is None else Archive(archive)
         if writer is not None:
-            writer.check_writable()
+            writer.check_writable(self.name)
         if resume and writer is None:
             raise ParameterError("resume", "resume=True needs the archive to resume from")
         finished = writer.finished_runs(self) if writer is not None and resume else {}

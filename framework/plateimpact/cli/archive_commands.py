@@ -23,6 +23,7 @@ from ..results import BatchResult, Outcome
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
 from .common import UsageError, check_directory
+from .stored_limits import compare_stored, kinds, show_stored
 
 
 def add_parsers(sub: Any) -> None:
@@ -36,15 +37,27 @@ def add_parsers(sub: Any) -> None:
     )
     p.set_defaults(command_function=reproduce_command)
 
-    p = sub.add_parser("show", help="list an archive's runs, their metadata and a summary")
+    p = sub.add_parser(
+        "show", help="list an archive's runs and stored limits, their metadata and a summary"
+    )
     p.add_argument("archive", help="HDF5 archive")
     p.set_defaults(command_function=show_command)
 
-    p = sub.add_parser("compare", help="compare two runs of an archive scene by scene")
+    p = sub.add_parser(
+        "compare",
+        help="compare two runs of an archive scene by scene, or two stored limits boundary "
+        "by boundary",
+    )
     p.add_argument("archive", help="HDF5 archive")
-    p.add_argument("run_a", help="run name (STUDY/RUN, or RUN when unique)")
-    p.add_argument("run_b", help="run name (STUDY/RUN, or RUN when unique)")
+    p.add_argument("run_a", help="run name (STUDY/RUN, or RUN when unique), or stored limits")
+    p.add_argument("run_b", help="run name (STUDY/RUN, or RUN when unique), or stored limits")
     p.add_argument("--png", metavar="FILE", help="overlay plot of the two runs")
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print one JSON object: the runs' summary, or how each boundary of two stored "
+        "limits moved (A, B: limits/NAME or NAME, as show lists them)",
+    )
     p.set_defaults(command_function=compare_command)
 
     p = sub.add_parser(
@@ -152,24 +165,41 @@ def show_command(args: argparse.Namespace) -> None:
             f"  run {meta['start_time']} on {meta['host']}, plateimpact "
             f"{meta['versions'].get('plateimpact')}, commit {meta['git_commit'][:12]}"
         )
+    show_stored(archive)
 
 
 def compare_command(args: argparse.Namespace) -> None:
     check_directory(args.png, "--png", "figure")
     archive = Archive(args.archive)
+    kind_a, kind_b = kinds(archive, [args.run_a, args.run_b])
+    if kind_a != kind_b:
+        run, stored = (args.run_a, args.run_b) if kind_a == "run" else (args.run_b, args.run_a)
+        raise UsageError(
+            f"{run!r} is a run and {stored!r} is stored limits: compare runs with runs, "
+            "limits with limits"
+        )
+    if kind_a == "limits":
+        if args.png:
+            raise UsageError("--png draws runs; stored limits are compared as text or --json")
+        compare_stored(archive, args.run_a, args.run_b, args.json)
+        return
     results = _study_results(archive, [args.run_a, args.run_b])
     name_a, name_b = archive.resolve(args.run_a), archive.resolve(args.run_b)
     comparison = results.compare(name_a, name_b)
-    study = results.study
-    scenes = study.scenes
-    print(f"{name_b} against {name_a}: {len(results[name_a])} scenes")
-    for i in comparison.changed:
-        print(
-            f"  {study.plate_labels[i]:>14} {np.degrees(scenes.impact_obliquity[i]):5.1f} deg "
-            f"{scenes.impact_speed[i]:7.1f} m/s: {Outcome(comparison.outcome_a[i]).label} -> "
-            f"{Outcome(comparison.outcome_b[i]).label}"
-        )
-    print(json.dumps(comparison.summary(), indent=2))
+    if args.json:
+        print(json.dumps({"a": name_a, "b": name_b, **comparison.summary()}, indent=2))
+    else:
+        study = results.study
+        scenes = study.scenes
+        print(f"{name_b} against {name_a}: {len(results[name_a])} scenes")
+        for i in comparison.changed:
+            print(
+                f"  {study.plate_labels[i]:>14} {np.degrees(scenes.impact_obliquity[i]):5.1f} "
+                f"deg {scenes.impact_speed[i]:7.1f} m/s: "
+                f"{Outcome(comparison.outcome_a[i]).label} -> "
+                f"{Outcome(comparison.outcome_b[i]).label}"
+            )
+        print(json.dumps(comparison.summary(), indent=2))
     if args.png:
         from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 

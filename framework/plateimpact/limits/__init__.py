@@ -3,10 +3,13 @@ tolerance, for any model (docs/limits.md).
 
 >>> limits = along_speed(simulation, sphere, plate, np.radians([0, 45, 60]))
 >>> limits.lines[1].ballistic_limit, limits.lines[1].bands
+>>> archive_limits("runs.h5", "plugging", limits)  # stored beside the studies
+>>> compare_limits(read_limits("runs.h5", "plugging"), read_limits("runs.h5", "hinge"))
 """
 
 from __future__ import annotations
 
+from .compare import BoundaryShift, LimitsComparison, LineComparison, compare_limits
 from .find import (
     MAX_SCAN_SCENES,
     OBLIQUITY_RANGE,
@@ -22,6 +25,7 @@ from .find import (
 from .finder import Located, locate
 from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine
 from .maps import MAP_OBLIQUITIES, MAP_SPEED_SAMPLES, OutcomeMap, outcome_map, outcome_maps
+from .records import archive_limits, read_limits, stored_limits
 from .regimes import REGIMES, Regime, regime_codes
 
 __all__ = [
@@ -39,15 +43,22 @@ __all__ = [
     "SPEED_TOLERANCE",
     "Band",
     "Boundary",
+    "BoundaryShift",
     "LimitLine",
     "Limits",
+    "LimitsComparison",
+    "LineComparison",
     "Located",
     "OutcomeMap",
     "Regime",
     "along_obliquity",
     "along_speed",
+    "archive_limits",
+    "compare_limits",
     "locate",
     "outcome_map",
     "outcome_maps",
+    "read_limits",
     "regime_codes",
+    "stored_limits",
 ]

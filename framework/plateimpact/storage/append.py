@@ -7,7 +7,7 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -58,6 +58,25 @@ def append(
     """Add one run to the archive file ``real`` (or create it): a copy is extended and
     renamed over the original, so a crash at any stage leaves the old file whole.
     Returns the run's name in its study."""
+
+    def add_run(f: h5py.File) -> str:
+        group = study_group(f, study, constants, real)
+        runs = group.require_group("runs")
+        run, k = variant.name, 1
+        while run in runs:
+            k += 1
+            run = f"{variant.name}.{k}"
+        write_run(runs.create_group(run), result, attributes)
+        return run
+
+    return append_with(real, add_run)
+
+
+def append_with(real: Path, write: Callable[[h5py.File], str]) -> str:
+    """Extend the archive file ``real`` (or create it) with ``write(file)``, which adds
+    its groups to the open copy and returns the name it stored them under: the archive
+    is copied, the copy extended, fsync'ed and renamed over the original, each stage a
+    fault point. The caller holds the archive's lock."""
     for stale in real.parent.glob(f".{real.name}.*.tmp"):  # left by killed writers
         stale.unlink(missing_ok=True)  # we hold the lock: no live writer uses one
     fd, name = tempfile.mkstemp(
@@ -75,13 +94,7 @@ def append(
                 f.attrs["format"] = FORMAT
                 f.attrs["format_version"] = FORMAT_VERSION
                 f.attrs["description"] = "plateimpact study archive; see docs/archive.md"
-            group = study_group(f, study, constants, real)
-            runs = group.require_group("runs")
-            run, k = variant.name, 1
-            while run in runs:
-                k += 1
-                run = f"{variant.name}.{k}"
-            write_run(runs.create_group(run), result, attributes)
+            stored = write(f)
             fault_point("flush")
         with open(temporary, "rb+") as handle:
             fault_point("fsync")
@@ -92,7 +105,7 @@ def append(
         fsync_directory(real.parent)
     finally:
         temporary.unlink(missing_ok=True)
-    return run
+    return stored
 
 
 def check_same_scenes(group: h5py.Group, study: StudyDefinition, path: Path) -> None:

@@ -7,6 +7,7 @@ leaves the previous archive, with every finished run, untouched (storage.append)
 writer at a time per real file, across threads and processes (storage.lock); readers
 never wait, since the file they open is always a whole one. A symlinked archive is
 followed: its target is written and locked, and keeps its mode, owner and group.
+Stored limits and maps (storage.records, under ``/limits``) are appended the same way.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import datetime as dt
 import json
 import os
 import stat
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import attrs
@@ -30,9 +31,11 @@ from ..ragged import Ragged
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from ..variant import Variant
 from . import append as append_module
+from . import records
 from .append import FORMAT, FORMAT_VERSION, StudyDefinition, append, check_same_scenes
 from .hdf5 import SEAL, digest, plain_attributes
 from .lock import ArchiveBusyError, locked
+from .records import LIMITS, Record
 
 #: How long a writer waits for another one to finish with the archive [s].
 WAIT = 300.0
@@ -69,10 +72,11 @@ class Archive:
 
     # -- writing ---------------------------------------------------------------------
 
-    def check_writable(self) -> None:
+    def check_writable(self, study: str | None = None) -> None:
         """Refuse early what :meth:`append_run` would refuse after a long run: a missing
         or unwritable directory, a target that is not a regular file, a read-only
-        archive, one that is damaged or of another format version."""
+        archive, one that is damaged or of another format version, a ``study`` named as
+        the stored limits' group."""
         directory = self.real.parent
         if not self.named or self.real.is_dir():
             raise ArchiveError(f"archive {self.path!s}: give an archive file name")
@@ -80,6 +84,8 @@ class Archive:
             raise ArchiveError(f"archive {self.path}: directory {directory} does not exist")
         if not os.access(directory, os.W_OK | os.X_OK):
             raise ArchiveError(f"archive {self.path}: directory {directory} is not writable")
+        if study is not None:
+            records.check_study_name(study, self.path)
         if self.real.exists():
             mode = os.stat(self.real).st_mode
             if not stat.S_ISREG(mode):
@@ -103,36 +109,60 @@ class Archive:
         (units and descriptions of the scene datasets). If another writer keeps the
         archive longer than ``wait``, the run is saved to a side archive beside it and
         :class:`ArchiveBusyError` says where: a finished run is never lost."""
+        self.check_writable(study.name)
+        run = self._append(
+            lambda real: append(real, study, variant, result, attributes, constants or {}),
+            lambda name: f"run {study.name}/{name}",
+            variant.name,
+            f"{study.name}.{variant.name}",
+        )
+        return f"{study.name}/{run}"
+
+    def append_record(self, name: str, record: Record) -> str:
+        """Add ``record`` (limits or a map, as plain data) as ``/limits/NAME``, or
+        ``NAME.2``, ... (atomically, as runs are added); returns the name it took."""
+        name = records.check_record_name(name)
         self.check_writable()
-        run = None
+        return self._append(
+            lambda real: records.append_record(real, name, record, self.path),
+            lambda stored: f"{LIMITS}/{stored}",
+            name,
+            f"{LIMITS}.{name}",
+        )
+
+    def _append(
+        self, add: Callable[[Path], str], label: Callable[[str], str], name: str, side_tag: str
+    ) -> str:
+        """Run ``add(real file)`` under the archive's lock; returns the name it stored.
+        ``label(name)`` names what is added in messages; busy, it goes to a side archive
+        ``STEM.SIDE_TAG.TIME.SUFFIX`` beside the real one."""
+        stored = None
         try:
             with locked(self.path, self.real, self.lock_path, self.wait):
                 self.check_writable()  # as it is now that we hold it
-                run = append(self.real, study, variant, result, attributes, constants or {})
+                stored = add(self.real)
                 append_module.fault_point("unlock")
         except ArchiveBusyError as exc:
             side = self.real.with_name(
-                f"{self.real.stem}.{study.name}.{variant.name}."
-                f"{dt.datetime.now(dt.UTC):%Y%m%dT%H%M%S%f}{self.real.suffix}"
+                f"{self.real.stem}.{side_tag}.{dt.datetime.now(dt.UTC):%Y%m%dT%H%M%S%f}"
+                f"{self.real.suffix}"
             )
-            append(side, study, variant, result, attributes, constants or {})
-            raise ArchiveBusyError(
-                f"{exc}; run {study.name}/{variant.name} saved to {side}"
-            ) from None
+            add(side)
+            raise ArchiveBusyError(f"{exc}; {label(name)} saved to {side}") from None
         except ArchiveError:
             raise
         except OSError as exc:
-            if run is not None:  # failed letting go of the lock: the run is in
+            if stored is not None:  # failed letting go of the lock: it is in
                 raise ArchiveError(
-                    f"archive {self.path}: run {study.name}/{run} was added, then letting go "
+                    f"archive {self.path}: {label(stored)} was added, then letting go "
                     f"of the lock failed: {exc.strerror or exc}"
                 ) from None
             # a full disk, a lost mount: the archive is as it was
             raise ArchiveError(
-                f"archive {self.path}: cannot add run {study.name}/{variant.name}: "
+                f"archive {self.path}: cannot add {label(name)}: "
                 f"{exc.strerror or exc} (the archive is unchanged)"
             ) from None
-        return f"{study.name}/{run}"
+        return stored
 
     def finished_runs(self, study: StudyDefinition) -> dict[str, str]:
         """The runs of ``study`` already in the archive, by variant name: those whose
@@ -141,7 +171,7 @@ class Archive:
         if not self.real.exists():
             return {}
         with self._open() as f:
-            if study.name not in f:
+            if study.name not in records.study_names(f):
                 return {}
             check_same_scenes(f[study.name], study, self.path)
             runs = f[study.name].get("runs", {})
@@ -197,7 +227,7 @@ class Archive:
     def _read(self, f: h5py.File, path: str) -> np.ndarray:
         try:
             return np.asarray(f[path][()])
-        except (OSError, KeyError, ValueError) as exc:
+        except (OSError, KeyError, ValueError, MemoryError) as exc:  # memory: a damaged shape
             raise ArchiveError(
                 f"archive {self.path}: {path} cannot be read ({_first_line(exc)}); "
                 "the file is damaged"
@@ -218,14 +248,14 @@ class Archive:
 
     def studies(self) -> list[str]:
         with self._open() as f:
-            return list(f)
+            return records.study_names(f)
 
     def runs(self) -> list[str]:
         """Every run as ``STUDY/RUN``, in the order written."""
         with self._open() as f:
             return [
                 f"{study}/{run}"
-                for study in f
+                for study in records.study_names(f)
                 for run in sorted(
                     f[study].get("runs", {}), key=lambda r: _start(f[study]["runs"][r])
                 )
@@ -265,12 +295,15 @@ class Archive:
             )
 
     def _study_name(self, f: h5py.File, name: str | None) -> str:
+        studies = records.study_names(f)
         if name is None:
-            if len(f) != 1:
-                raise UnknownNameError(f"{self.path} holds studies {', '.join(f)}: name one")
-            return str(next(iter(f)))
-        if name not in f:
-            raise UnknownNameError(f"no study {name!r} in {self.path}; studies: {', '.join(f)}")
+            if len(studies) != 1:
+                raise UnknownNameError(f"{self.path} holds studies {', '.join(studies)}: name one")
+            return studies[0]
+        if name not in studies:
+            raise UnknownNameError(
+                f"no study {name!r} in {self.path}; studies: {', '.join(studies)}"
+            )
         return name
 
     def metadata(self, run: str) -> dict[str, object]:
@@ -317,6 +350,30 @@ class Archive:
                 path = f"{base}/trajectory"
                 trajectory = self._read_ragged(f, path, "count", [], list(TRAJECTORY_FIELDS))
             return BatchResult(columns, trajectory, craters=craters)
+
+    # -- stored limits and maps ----------------------------------------------------------
+
+    def limits_names(self) -> list[str]:
+        """The stored limits and maps (records under ``/limits``), in the order written."""
+        with self._open() as f:
+            return records.record_names(f)
+
+    def record(self, name: str) -> Record:
+        """The stored record ``name`` (``NAME`` or ``limits/NAME``), its attributes checked
+        against their digest; UnknownNameError lists the stored names."""
+        with self._open() as f:
+            names = records.record_names(f)
+            if name not in names:
+                name = name.removeprefix(f"{LIMITS}/")
+            if name not in names:
+                raise UnknownNameError(
+                    f"no stored limits {name!r} in {self.path} "
+                    f"(stored: {', '.join(names) or 'none'})"
+                )
+            self._check_seal(f[LIMITS])
+            return records.read_record(
+                f[f"{LIMITS}/{name}"], self._check_seal, lambda path: self._read(f, path)
+            )
 
 
 def _run_path(run: str) -> str:

@@ -12,18 +12,32 @@ import numpy as np
 from ..parameters import Parameter
 from ..ragged import Ragged
 
-#: Attribute holding the SHA-256 of a study's or run's other attributes.
+#: Attribute holding the SHA-256 of a study's, run's or stored record's other attributes.
 SEAL = "attributes_sha256"
 
 
 def write_dataset(
-    group: h5py.Group, name: str, data: np.ndarray, units: str, description: str
+    group: h5py.Group,
+    name: str,
+    data: np.ndarray,
+    units: str,
+    description: str,
+    long_name: str | None = None,
 ) -> None:
-    """A chunked, fletcher32-checksummed 1-D dataset with ``units`` and ``description``."""
+    """A chunked, fletcher32-checksummed dataset with ``units`` and ``description`` (and
+    ``long_name``, if given). 1-D unless ``data`` has more dimensions (an outcome map's
+    grid), which are chunked whole up to 2**16 values."""
     data = np.asarray(data)
-    chunk = (int(min(max(data.size, 1), 1 << 16)),)
-    ds = group.create_dataset(name, data=data, chunks=chunk, maxshape=(None,), fletcher32=True)
+    if data.ndim <= 1:
+        chunk: tuple[int, ...] = (int(min(max(data.size, 1), 1 << 16)),)
+    else:
+        rows = max(1, (1 << 16) // max(int(np.prod(data.shape[1:])), 1))
+        chunk = (min(max(data.shape[0], 1), rows), *(max(n, 1) for n in data.shape[1:]))
+    maxshape = (None,) * max(data.ndim, 1)
+    ds = group.create_dataset(name, data=data, chunks=chunk, maxshape=maxshape, fletcher32=True)
     ds.attrs["units"] = units
+    if long_name is not None:
+        ds.attrs["long_name"] = long_name
     ds.attrs["description"] = description
 
 

@@ -1,0 +1,150 @@
+"""Stored records: named results other than runs, kept in an archive beside its studies
+(docs/archive.md, "Limits and outcome maps").
+
+A record is plain data, so that storage needs nothing of what it holds: sealed
+attributes (strings and numbers) and datasets, each with its SI ``units``, a
+``long_name`` and a ``description``. Records live under the top-level group ``/limits``,
+one group each, ``/limits/NAME``; a name already there gets ``.2``, ``.3``, ... as runs
+do. The study name ``limits`` is therefore reserved.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import attrs
+import h5py
+import numpy as np
+
+from ..errors import ArchiveError, ParameterError
+from .append import append_with
+from .hdf5 import seal, write_dataset
+
+#: The top-level group of the stored records; a study may not take its name.
+LIMITS = "limits"
+#: Entry names that an older plateimpact, which takes ``/limits`` for a study, would
+#: misread as that study's groups.
+RESERVED_NAMES = ("runs", "scenes")
+
+
+@attrs.frozen(eq=False)
+class Column:
+    """One dataset of a record: ``data`` [``units``, SI; "1" for none]. Read back, a
+    column has its data only (storage.records.read_record)."""
+
+    data: np.ndarray
+    units: str
+    long_name: str
+    description: str = ""
+
+
+@attrs.frozen(eq=False)
+class Record:
+    """What a record stores: ``attributes`` (str, int, float or bool; sealed) and
+    ``columns`` by their path inside the record's group (``lines/fixed``)."""
+
+    attributes: dict[str, object]
+    columns: dict[str, Column]
+
+
+def is_container(f: h5py.File, name: str) -> bool:
+    """Whether the top-level group ``name`` holds records rather than a study (an archive
+    written before records were stored may hold a study named ``limits``)."""
+    return name == LIMITS and "scenes" not in f[name]
+
+
+def study_names(f: h5py.File) -> list[str]:
+    """The archive's studies: its top-level groups but the records' one."""
+    return [name for name in f if not is_container(f, name)]
+
+
+def check_study_name(name: str, path: Path) -> None:
+    if name == LIMITS:
+        raise ArchiveError(
+            f"archive {path}: the study name {LIMITS!r} is reserved for stored limits and "
+            "maps; rename the study"
+        )
+
+
+def check_record_name(name: object) -> str:
+    """A record's requested name: printable, no '/', no surrounding space, not one an
+    older reader would misread."""
+    text = name if isinstance(name, str) else ""
+    if not text or text != text.strip() or "/" in text or not text.isprintable():
+        raise ParameterError(
+            "name", f"name must be a printable name without '/' or surrounding space, got {name!r}"
+        )
+    if text in RESERVED_NAMES:
+        raise ParameterError(
+            "name",
+            f"name {text!r} is reserved (an older plateimpact would misread it); "
+            f"any other name, but not {' or '.join(RESERVED_NAMES)}",
+        )
+    return text
+
+
+def write_record(f: h5py.File, name: str, record: Record, path: Path) -> str:
+    """Add ``record`` to the open archive ``f`` as ``/limits/NAME`` (``NAME.2``, ... if
+    taken); returns the name it was stored under."""
+    if LIMITS in f and not is_container(f, LIMITS):
+        raise ArchiveError(
+            f"archive {path} holds a study named {LIMITS!r}, where limits are stored; "
+            "store them in another archive"
+        )
+    if LIMITS not in f:
+        container = f.create_group(LIMITS)
+        container.attrs["description"] = (
+            "stored limits and outcome maps, one group each; see docs/archive.md"
+        )
+        seal(container)
+    container = f[LIMITS]
+    stored, k = name, 1
+    while stored in container:
+        k += 1
+        stored = f"{name}.{k}"
+    group = container.create_group(stored)
+    for key, value in record.attributes.items():
+        group.attrs[key] = value
+    seal(group)
+    for where, column in record.columns.items():
+        parent, _, leaf = where.rpartition("/")
+        target = group.require_group(parent) if parent else group
+        write_dataset(target, leaf, column.data, column.units, column.description, column.long_name)
+    return stored
+
+
+def append_record(real: Path, name: str, record: Record, path: Path) -> str:
+    """Add ``record`` to the archive file ``real`` through the atomic append
+    (storage.append: copy, extend, replace, each stage a fault point); ``path`` as the
+    user named the archive, for messages. The caller holds the lock."""
+    return append_with(real, lambda f: write_record(f, name, record, path))
+
+
+def record_names(f: h5py.File) -> list[str]:
+    """The records of the open archive ``f``, in the order written."""
+    if LIMITS not in f or not is_container(f, LIMITS):
+        return []
+    group = f[LIMITS]
+    return sorted(group, key=lambda name: str(group[name].attrs.get("creation_time", "")))
+
+
+def read_record(
+    group: h5py.Group,
+    check_seal: Callable[[h5py.Group], dict[str, object]],
+    read: Callable[[str], np.ndarray],
+) -> Record:
+    """The record in ``group``: its attributes through ``check_seal`` (the digest
+    checked), every dataset through ``read`` (by its path in the file). The datasets'
+    own attributes (units, names) are for readers without plateimpact and are not read
+    back: the record's kind says its units, and an attribute in a damaged object header
+    can crash the HDF5 library itself, where no error can be caught (found by fuzzing)."""
+    attributes = check_seal(group)
+    found: list[str] = []
+
+    def visit(name: str, item: object) -> None:
+        if isinstance(item, h5py.Dataset):
+            found.append(name)
+
+    group.visititems(visit)
+    return Record(attributes, {where: Column(read(group[where].name), "", "") for where in found})
