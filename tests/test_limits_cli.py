@@ -130,3 +130,37 @@ def test_a_map_of_degrees_round_trips_its_rows():
     )  # fmt: skip
     assert [line.to_json()["obliquity_deg"] for line in found.limits.lines] == [0.0, 15.0]
     assert math.isclose(found.limits.resolution, 200.0)
+
+
+def test_limits_and_maps_go_into_an_archive_that_show_and_compare_read(tmp_path):
+    archive = tmp_path / "limits.h5"
+    code, out, err = run_cli([*ALONG_SPEED, "--json", "--archive", str(archive)])
+    assert code == 0, err
+    printed = json.loads(out.splitlines()[0])
+    assert out.splitlines()[1] == f"archive: {archive} (limits/2024-T3_3.18_plugging)"
+    stored = limits.read_limits(archive, "2024-T3_3.18_plugging")
+    assert [line.to_json() for line in stored.lines] == printed["lines"]
+    code, _, err = run_cli([*ALONG_SPEED, "--failure", "hinge", "--archive", str(archive)])
+    assert code == 0, err
+    small = ["--speeds", "100:900:9", "--obliquities", "0,45", "--png", str(tmp_path / "m.png")]
+    code, out, err = run_cli(["map", *PLATE, *small, "--archive", str(archive), "--name", "m"])
+    assert code == 0, err
+    assert isinstance(limits.read_limits(archive, "m"), limits.OutcomeMap)
+    code, out, err = run_cli(["show", str(archive)])
+    assert code == 0 and "limits/m: outcome map" in out, err
+    code, out, err = run_cli(["compare", str(archive), "2024-T3_3.18_plugging",
+                              "2024-T3_3.18_hinge"])  # fmt: skip
+    assert code == 0 and "embedment after failure -> perforation" in out, err
+
+
+def test_an_archive_that_cannot_take_the_result_is_refused_before_any_work(tmp_path):
+    archive = tmp_path / "kept.h5"
+    code, _, err = run_cli([*ALONG_SPEED, "--archive", str(archive)])
+    assert code == 0, err
+    archive.chmod(0o444)
+    before = archive.read_bytes()
+    code, out, err = run_cli([*ALONG_SPEED, "--archive", str(archive)])
+    assert_one_line(code, err, "read-only")
+    assert out == "" and archive.read_bytes() == before
+    code, _, err = run_cli([*ALONG_SPEED, "--name", "x"])
+    assert_one_line(code, err, "--name names what --archive stores")

@@ -14,6 +14,7 @@ import numpy as np
 from .. import limits as lim
 from ..registry import PluginRegistry
 from ..results import Outcome
+from ..storage.archive import Archive
 from .common import UsageError, check_directory, csv_text, save_figure_atomically, write_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
@@ -49,6 +50,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--csv", metavar="FILE", help="write the bands as CSV")
     p.add_argument("--png", metavar="FILE", help="draw the bands")
+    _add_archive(p, "PRESET_FAILURE")
     add_body_options(p, registry)
     add_model_options(p, registry)
     p.set_defaults(command_function=limits_command)
@@ -72,9 +74,38 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         "ballistic and ricochet limits against obliquity for every --preset",
     )
     p.add_argument("--png", metavar="FILE", required=True, help="draw here")
+    _add_archive(p, "map_PRESET_FAILURE")
     add_body_options(p, registry, many_presets=True)
     add_model_options(p, registry)
     p.set_defaults(command_function=map_command)
+
+
+def _add_archive(p: argparse.ArgumentParser, default: str) -> None:
+    p.add_argument(
+        "--archive", metavar="FILE", help="also store the result in this HDF5 archive (show, "
+        "compare read it)",
+    )  # fmt: skip
+    p.add_argument(
+        "--name",
+        help=f"the stored name (default {default}, with '/' as '_'; NAME.2, ... if taken)",
+    )
+
+
+def _writable_archive(args: argparse.Namespace) -> Archive | None:
+    """The --archive to store into, refused now if it could not take the result."""
+    if args.name is not None and args.archive is None:
+        raise UsageError("--name names what --archive stores; give --archive FILE")
+    if args.archive is None:
+        return None
+    archive = Archive(args.archive)
+    archive.check_writable()
+    return archive
+
+
+def _store(archive: Archive | None, name: str, found: lim.Limits | lim.OutcomeMap) -> None:
+    if archive is not None:
+        stored = lim.archive_limits(archive, name.replace("/", "_"), found)
+        print(f"archive: {archive.path} (limits/{stored})")
 
 
 def _number(text: str, flag: str) -> float:
@@ -116,6 +147,7 @@ def _is_range(text: str | None) -> bool:
 def limits_command(args: argparse.Namespace) -> None:
     check_directory(args.csv, "--csv")
     check_directory(args.png, "--png", "figure")
+    archive = _writable_archive(args)
     for outcome in args.outcome or ():
         if outcome not in OUTCOMES:
             raise UsageError(f"--outcome must be one of {', '.join(OUTCOMES)}, got {outcome!r}")
@@ -165,8 +197,9 @@ def limits_command(args: argparse.Namespace) -> None:
         save_figure_atomically(plot_bands(found, label), args.png)
     if args.json:
         print(json.dumps({"preset": label, **found.to_json()}))
-        return
-    _print(found, label, args.outcome)
+    else:
+        _print(found, label, args.outcome)
+    _store(archive, args.name or f"{label}_{simulation.model.failure.name}", found)
 
 
 def _csv(found: lim.Limits) -> str:
@@ -213,6 +246,7 @@ def _print(found: lim.Limits, label: str, outcomes: list[str] | None) -> None:
 
 def map_command(args: argparse.Namespace) -> None:
     check_directory(args.png, "--png", "figure")
+    archive = _writable_archive(args)
     typed(args).update({"speeds": "--speeds", "impact_speed": "--speeds",
                         "obliquities": "--obliquities", "impact_obliquity": "--obliquities",
                         "tolerance": "--tolerance", "speed_samples": "--speeds"})  # fmt: skip
@@ -233,9 +267,9 @@ def map_command(args: argparse.Namespace) -> None:
     simulation = choice.simulation()
     plates = []
     for preset in presets_given:
-        one = copy.copy(args)
-        one.preset = preset
-        plates.append(bodies(one, choice, simulation.model))
+        given = copy.copy(args)
+        given.preset = preset
+        plates.append(bodies(given, choice, simulation.model))
     spheres = {sphere for sphere, _, _ in plates}  # one, from --radius and --mass
     found = lim.outcome_maps(simulation, spheres.pop(), [plate for _, plate, _ in plates], span,
                              samples, rows, tolerance=tolerance)  # fmt: skip
@@ -250,3 +284,9 @@ def map_command(args: argparse.Namespace) -> None:
     draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves
     save_figure_atomically(draw(maps), args.png)
     print(f"figure:  {args.png}")
+    failure = simulation.model.failure.name
+    for label, drawn in maps:
+        name = f"map_{label}_{failure}"
+        if args.name:
+            name = args.name if len(maps) == 1 else f"{args.name}_{label}"
+        _store(archive, name, drawn)
