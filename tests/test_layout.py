@@ -163,3 +163,19 @@ def test_plotting_leaves_the_users_matplotlib_backend_alone():
         "import matplotlib.pyplot as plt; print(before, plt.get_backend())"
     )
     assert run_python(code, MPLBACKEND="svg") == "svg svg"
+
+
+def test_every_package_directory_is_installed():
+    """A non-editable install ships only the packages pyproject.toml lists (CI installs so)."""
+    import tomllib
+
+    listed = set(
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    )
+    roots = {"plateimpact": CORE, "plateimpact_plugins": ROOT / "plugins" / "plateimpact_plugins"}
+    found = {"plateimpact_studies"}
+    for package, root in roots.items():
+        for init in root.rglob("__init__.py"):
+            parts = init.parent.relative_to(root).parts
+            found.add(".".join((package, *parts)))
+    assert found == listed
