@@ -1,4 +1,5 @@
-"""Every figure family of the report in one archive, with one PNG per family.
+"""Every figure family of the report in one archive, with one PNG per family, and the
+outcome maps and limit curves of the five plates.
 
 python studies/reproduce.py [--out DIR]      (what `plateimpact reproduce` runs)
 """
@@ -8,6 +9,11 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+
+import numpy as np
+
+import plateimpact as pi
+from plateimpact import limits, plotting, presets
 
 try:
     from . import (
@@ -36,6 +42,38 @@ FAMILIES = (
     fig38_44_sae1010_1_47mm,
 )
 ARCHIVE_NAME = "report.h5"
+#: The maps' grid: 100 speeds over 50-2000 m/s, obliquities 0-84 deg by 2 (the five
+#: plates found together in about 5 s; `plateimpact map` draws finer ones).
+MAP_SPEEDS, MAP_SAMPLES = (50.0, 2000.0), 100
+MAP_OBLIQUITIES = np.radians(np.arange(0.0, 85.0, 2.0))
+
+
+def outcome_maps(
+    out: Path, archive: Path, resume: bool = False
+) -> tuple[list[limits.OutcomeMap], list[Path]]:
+    """The outcome maps of the five plates (default sphere, plugging, dopri5), stored in
+    ``archive`` as ``limits/map_PLATE`` (with ``resume``, read back if there), and drawn:
+    ``outcome_maps.png`` and ``limit_curves.png``."""
+    from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
+
+    names = [f"map_{plate.replace('/', '_')}" for plate in presets.PLATES]
+    stored = set(limits.stored_limits(archive)) if resume and archive.exists() else set()
+    kept = [limits.read_limits(archive, name) for name in names if name in stored]
+    found = [m for m in kept if isinstance(m, limits.OutcomeMap)]
+    if len(found) < len(names):
+        found = limits.outcome_maps(
+            pi.Simulation.from_names(), presets.DEFAULT_SPHERE,
+            [presets.plate(plate) for plate in presets.PLATES], MAP_SPEEDS, MAP_SAMPLES,
+            MAP_OBLIQUITIES,
+        )  # fmt: skip
+        for name, drawn in zip(names, found, strict=True):
+            if name not in stored:  # a resumed archive keeps the maps it has
+                limits.archive_limits(archive, name, drawn)
+    maps = list(zip(presets.PLATES, found, strict=True))
+    paths = [out / "outcome_maps.png", out / "limit_curves.png"]
+    plotting.save(plot_outcome_map(maps), str(paths[0]))
+    plotting.save(plot_limit_curves(maps), str(paths[1]))
+    return found, paths
 
 
 def reproduce(
@@ -49,6 +87,7 @@ def reproduce(
     figures = [run_and_plot(f.study(), out, archive, progress, resume=resume) for f in FAMILIES]
     craters = fig35_37_craters_60deg.study()
     figures.append(run_and_plot(craters, out, archive, progress, craters=True, resume=resume))
+    figures += outcome_maps(out, archive, resume)[1]
     return archive, figures
 
 

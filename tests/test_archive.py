@@ -16,6 +16,7 @@ import pytest
 import plateimpact as pi
 from plateimpact.cli import main as cli
 from plateimpact.crater import crater_section
+from plateimpact.limits import stored_limits
 
 SPEEDS = np.linspace(150.0, 1200.0, 8)
 
@@ -351,9 +352,12 @@ def test_reproduce_writes_one_archive_and_a_figure_per_family(tmp_path, capsys):
     assert len(archive.studies()) == 6  # five figure families and the craters of 35-37
     assert len(archive.runs()) == 8  # two comparison families run two variants each
     assert archive.results("craters_60deg/default").craters is not None
+    maps = [f"map_{plate.replace('/', '_')}" for plate in pi.presets.PLATES]
+    assert stored_limits(out / "report.h5") == maps  # and the five plates' outcome maps
     pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 6 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
+    assert len(pngs) == 8 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
     assert str(out / "report.h5") in capsys.readouterr().out
     assert cli(["reproduce", "--out", str(out), "--resume"]) == 0  # everything is there
     assert len(pi.Archive(out / "report.h5").runs()) == 8
+    assert stored_limits(out / "report.h5") == maps  # read back, not stored twice
     assert cli(["reproduce", "--out", str(tmp_path / "missing" / "report")]) == 2
