@@ -15,24 +15,17 @@ import numpy as np
 import pytest
 from test_archive import flip_bytes
 from test_archive_writers import STAGES, debris
+from test_limits import ESTAR, E, P
 from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.limits import Regime
 from plateimpact.storage import append as appending
 from plateimpact.storage.lock import locked
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = "2024-T3/3.18"
 OBLIQUITIES = np.radians([0.0, 45.0])
-R, RSTAR, E, ESTAR, P = (
-    Regime(pi.Outcome.RICOCHET, False),
-    Regime(pi.Outcome.RICOCHET, True),
-    Regime(pi.Outcome.EMBEDMENT, False),
-    Regime(pi.Outcome.EMBEDMENT, True),
-    Regime(pi.Outcome.PERFORATION, True),
-)
 
 
 def along_speed(failure: str) -> limits.Limits:
