@@ -12,6 +12,11 @@ from plateimpact import plotting
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]
 
 
+def tagged(study: pi.Study, tag: str | None) -> dict[str, str] | None:
+    """The run names of ``study``'s variants stored ``--as TAG``: ``VARIANT@TAG``."""
+    return None if tag is None else {v.name: f"{v.name}@{tag}" for v in study.variants}
+
+
 def run_and_plot(
     study: pi.Study,
     out: Path,
@@ -19,11 +24,17 @@ def run_and_plot(
     progress: bool | None = None,
     craters: bool = False,
     resume: bool = False,
+    overwrite: bool = False,
+    tag: str | None = None,
 ) -> Path:
     """Run ``study`` (appending its runs to ``archive``; with ``resume``, only those not
-    there yet) and draw ``out/<study>.png``: exit curves, or with ``craters`` the crater
-    sections (the runs then keep paths and craters)."""
-    results = study.run(archive=archive, progress=progress, craters=craters, resume=resume)
+    there yet; with ``overwrite`` replacing them; with ``tag``, as ``VARIANT@TAG``) and
+    draw ``out/<study>.png``: exit curves, or with ``craters`` the crater sections (the
+    runs then keep paths and craters)."""
+    results = study.run(
+        archive=archive, progress=progress, craters=craters, resume=resume,
+        overwrite=overwrite, run_names=tagged(study, tag),
+    )  # fmt: skip
     if craters:
         figure = plotting.plot_study_paths(results, kind="crater")
     else:

@@ -24,7 +24,7 @@ try:
         fig35_37_craters_60deg,
         fig38_44_sae1010_1_47mm,
     )
-    from ._family import run_and_plot
+    from ._family import run_and_plot, tagged
 except ImportError:  # run as a script
     import fig11_17_6061t6_9_53mm
     import fig18_24_2024t3_6_35mm
@@ -32,7 +32,7 @@ except ImportError:  # run as a script
     import fig32_34_2024t3_1_27mm
     import fig35_37_craters_60deg
     import fig38_44_sae1010_1_47mm
-    from _family import run_and_plot
+    from _family import run_and_plot, tagged
 
 FAMILIES = (
     fig11_17_6061t6_9_53mm,
@@ -49,14 +49,16 @@ MAP_OBLIQUITIES = np.radians(np.arange(0.0, 85.0, 2.0))
 
 
 def outcome_maps(
-    out: Path, archive: Path, resume: bool = False
+    out: Path, archive: Path, resume: bool = False, overwrite: bool = False, tag: str | None = None
 ) -> tuple[list[limits.OutcomeMap], list[Path]]:
     """The outcome maps of the five plates (default sphere, plugging, dopri5), stored in
-    ``archive`` as ``limits/map_PLATE`` (with ``resume``, read back if there), and drawn:
-    ``outcome_maps.png`` and ``limit_curves.png``."""
+    ``archive`` as ``limits/map_PLATE`` (or ``map_PLATE@TAG``; with ``resume``, read back
+    if there; with ``overwrite``, replaced), and drawn: ``outcome_maps.png`` and
+    ``limit_curves.png``."""
     from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
-    names = [f"map_{plate.replace('/', '_')}" for plate in presets.PLATES]
+    suffix = "" if tag is None else f"@{tag}"
+    names = [f"map_{plate.replace('/', '_')}{suffix}" for plate in presets.PLATES]
     stored = set(limits.stored_limits(archive)) if resume and archive.exists() else set()
     kept = [limits.read_limits(archive, name) for name in names if name in stored]
     found = [m for m in kept if isinstance(m, limits.OutcomeMap)]
@@ -68,7 +70,7 @@ def outcome_maps(
         )  # fmt: skip
         for name, drawn in zip(names, found, strict=True):
             if name not in stored:  # a resumed archive keeps the maps it has
-                limits.archive_limits(archive, name, drawn)
+                limits.archive_limits(archive, name, drawn, overwrite=overwrite)
     maps = list(zip(presets.PLATES, found, strict=True))
     paths = [out / "outcome_maps.png", out / "limit_curves.png"]
     plotting.save(plot_outcome_map(maps), str(paths[0]))
@@ -77,27 +79,42 @@ def outcome_maps(
 
 
 def reproduce(
-    out: Path, progress: bool | None = None, resume: bool = False
+    out: Path,
+    progress: bool | None = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    tag: str | None = None,
 ) -> tuple[Path, list[Path]]:
-    """Run every family into ``out/report.h5`` and draw its PNGs. An existing archive is
-    appended to (its earlier runs kept; the new ones get a ``.2``, ``.3`` suffix), or with
-    ``resume`` its finished runs are read back and only the missing ones run."""
+    """Run every family into ``out/report.h5`` and draw its PNGs. Runs already in the
+    archive are refused before anything runs, unless ``resume`` (read them back, run
+    only the missing ones), ``overwrite`` (replace them) or ``tag`` (store the new runs
+    as ``VARIANT@TAG``, the maps as ``map_PLATE@TAG``)."""
     out.mkdir(parents=True, exist_ok=True)
     archive = out / ARCHIVE_NAME
-    figures = [run_and_plot(f.study(), out, archive, progress, resume=resume) for f in FAMILIES]
+    studies = [f.study() for f in FAMILIES]
     craters = fig35_37_craters_60deg.study()
-    figures.append(run_and_plot(craters, out, archive, progress, craters=True, resume=resume))
-    figures += outcome_maps(out, archive, resume)[1]
+    for study in [*studies, craters]:  # a run that is there is refused before any runs
+        names = tagged(study, tag)
+        study.check_archive(archive, resume=resume, overwrite=overwrite, run_names=names)
+    figures = [
+        run_and_plot(s, out, archive, progress, resume=resume, overwrite=overwrite, tag=tag)
+        for s in studies
+    ]
+    figures.append(run_and_plot(craters, out, archive, progress, True, resume, overwrite, tag))
+    figures += outcome_maps(out, archive, resume, overwrite, tag)[1]
     return archive, figures
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="report", help="output directory (created)")
-    parser.add_argument("--resume", action="store_true", help="run only the missing runs")
+    rerun = parser.add_mutually_exclusive_group()
+    rerun.add_argument("--resume", action="store_true", help="run only the missing runs")
+    rerun.add_argument("--overwrite", action="store_true", help="replace the runs there")
+    rerun.add_argument("--as", dest="tag", metavar="TAG", help="store new runs as VARIANT@TAG")
     args = parser.parse_args()
     start = time.perf_counter()
-    archive, figures = reproduce(Path(args.out), resume=args.resume)
+    archive, figures = reproduce(Path(args.out), None, args.resume, args.overwrite, args.tag)
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")

@@ -70,38 +70,56 @@ def test_archive_is_self_describing_in_plain_h5py(tmp_path):
     small_study().run(archive=path, craters=True)
     datasets = []
     with h5py.File(path, "r") as f:  # no project code from here on
-        assert f.attrs["format"] == "plateimpact-archive"
-        f.visititems(
+        assert f.attrs["format"] == "plateimpact-archive" and f.attrs["format_version"] == 2
+        run = f["t318/runs/plugging"]  # an external link into the run's data file
+        assert f["t318/runs"].get("plugging", getlink=True).filename.startswith("a.h5.d/")
+        run.visititems(
             lambda name, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None
         )
         assert datasets
         for ds in datasets:
-            assert "units" in ds.attrs and "description" in ds.attrs, ds.name
+            if (
+                ds.dtype.kind == "O"
+                or "units" not in ds.attrs
+                and ds.name.endswith(("_sample", "_point"))
+            ):  # the plate's label; netCDF's dimensions without coordinates
+                continue
+            assert "units" in ds.attrs and "long_name" in ds.attrs, ds.name
+            assert "description" in ds.attrs, ds.name
             assert ds.fletcher32 and ds.chunks is not None, ds.name
-        run = f["t318/runs/plugging"]
-        counts = run["trajectory/count"][()]
-        assert counts.sum() == run["trajectory/time"].shape[0]
-        assert run["crater/counts"][()].sum() == run["crater/depth"].shape[0]
-        assert run["crater/depth"].attrs["units"] == "m"
-        assert run["results/exit_speed"].attrs["units"] == "m/s"
+        counts = run["trajectory_count"][()]
+        assert counts.sum() == run["trajectory_time"].shape[0]
+        assert run["crater_count"][()].sum() == run["crater_depth"].shape[0]
+        assert run["crater_depth"].attrs["units"] == "m"
+        assert run["exit_speed"].attrs["units"] == "m/s"
+        assert list(run["outcome"].attrs["flag_values"]) == [1, 2, 3]
 
 
 def test_runs_append_without_touching_earlier_ones(tmp_path):
     path = tmp_path / "a.h5"
     study = small_study()
     first = study.run(archive=path)
-    with h5py.File(path, "r") as f:
-        before = f["t318/runs/plugging/results/exit_speed"][()]
-    second = study.run(archive=path)  # the same study again: runs get a suffix
     archive = pi.Archive(path)
-    assert archive.runs() == [
-        "t318/plugging",
-        "t318/large-pstar",
-        "t318/plugging.2",
-        "t318/large-pstar.2",
-    ]
-    np.testing.assert_array_equal(archive.results("t318/plugging").exit_speed, before)
-    assert_same(first["plugging"], second["plugging"])
+    files = {run: archive.data_file(run).read_bytes() for run in archive.runs()}
+    index = path.read_bytes()
+    # The same study again is refused before it runs: never a silent plugging.2.
+    with pytest.raises(pi.ArchiveError, match="already has run t318/plugging: keep it"):
+        study.run(archive=path)
+    assert path.read_bytes() == index
+    again = study.run(archive=path, run_names={"plugging": "plugging-b", "large-pstar": "lp-b"})
+    assert archive.runs() == ["t318/plugging", "t318/large-pstar", "t318/plugging-b", "t318/lp-b"]
+    for run, data in files.items():  # earlier runs' files are never written again
+        assert archive.data_file(run).read_bytes() == data
+    assert_same(first["plugging"], again["plugging"])
+    assert_same(first["plugging"], archive.results("plugging-b"))
+    # overwrite replaces a run atomically; its old data file goes once the index is in.
+    old = archive.data_file("t318/plugging")
+    study.run(archive=path, overwrite=True)
+    assert len(archive.runs()) == 4 and not old.exists()
+    assert archive.data_file("t318/plugging") != old
+    assert_same(first["plugging"], archive.results("t318/plugging"))
+    with pytest.raises(pi.ParameterError, match="give one"):
+        study.run(archive=path, overwrite=True, resume=True)
     other = pi.Study.grid("t318", ["2024-T3/1.27"], [0], SPEEDS, [pi.Variant("x")])
     with pytest.raises(pi.ArchiveError, match="different study"):
         other.run(archive=path)
@@ -163,12 +181,16 @@ def test_resume_reads_back_finished_runs_and_runs_the_rest(tmp_path):
     assert study.run(archive=path, resume=True).runs.keys() == {"fast", "coarse"}
     assert archive.runs() == ["r/fast", "r/coarse"]  # nothing left to do
     changed = pi.Variant("fast", integrator_settings={"rtol": 1e-7})  # same name, other model
-    pi.Study.grid("r", ["2024-T3/3.18"], [0, 60], speeds, changed).run(archive=path, resume=True)
-    assert archive.runs()[-1] == "r/fast.2"
+    with pytest.raises(pi.ArchiveError, match="r/fast with other plug-ins or settings"):
+        pi.Study.grid("r", ["2024-T3/3.18"], [0, 60], speeds, changed).run(
+            archive=path, resume=True
+        )
     with pytest.raises(pi.ParameterError, match="resume"):
         study.run(resume=True)
     with_craters = study.run(archive=path, resume=True, craters=True)  # not kept: run again
-    assert with_craters["coarse"].craters is not None and archive.runs()[-1] == "r/coarse.2"
+    assert with_craters["coarse"].craters is not None
+    assert sorted(archive.runs()) == ["r/coarse", "r/fast"]  # replaced, not added
+    assert archive.results("r/coarse").craters is not None
 
 
 HOLD_LOCK = """
@@ -206,14 +228,15 @@ def test_a_live_writer_makes_others_wait_or_save_aside_and_readers_read(tmp_path
         assert len(pi.Archive(path).runs()) == 2  # the archive itself untouched
         # A study given such an archive warns per run and still returns its results.
         with pytest.warns(pi.ArchiveWaitWarning, match="saved to ") as warned:
-            again = study.run(archive=pi.Archive(path, wait=0.0))
+            again = study.run(archive=pi.Archive(path, wait=0.0), overwrite=True)
         assert len(warned) == len(study.variants)
         assert_same(results["plugging"], again["plugging"])
         assert len(pi.Archive(path).runs()) == 2
     finally:
         holder.stdin.close()
         holder.wait()
-    study.run(archive=path)  # the lock is free again (its file stays, naming the last writer)
+    # the lock is free again (its file stays, naming the last writer)
+    study.run(archive=path, run_names={"plugging": "p2", "large-pstar": "l2"})
     assert len(pi.Archive(path).runs()) == 4
 
 
@@ -230,7 +253,7 @@ def flip_bytes(path, dataset):
 def test_bad_archives_give_one_line_errors(tmp_path, capsys):
     path = tmp_path / "a.h5"
     small_study().run(archive=path)
-    flip_bytes(path, "t318/runs/plugging/results/exit_speed")
+    flip_bytes(pi.Archive(path).data_file("plugging"), "exit_speed")
     with pytest.raises(pi.ArchiveError, match="damaged"):
         pi.Archive(path).results("plugging")
     not_hdf5 = tmp_path / "notes.h5"

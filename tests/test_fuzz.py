@@ -64,27 +64,46 @@ def test_malformed_command_lines_give_one_line_errors(command, options):
 
 
 class ArchiveBytes(bytes):
-    """A valid archive's bytes, shown by size (hypothesis prints the test's arguments)."""
+    """A file's bytes, shown by size (hypothesis prints the test's arguments)."""
 
     def __repr__(self) -> str:
-        return f"<archive of {len(self)} bytes>"
+        return f"<{len(self)} bytes>"
+
+
+class ArchiveFiles(dict):
+    """A valid archive's files by their path in its directory: the index ``a.h5`` and
+    its data files ``a.h5.d/*.nc``."""
+
+    def __repr__(self) -> str:
+        return f"<archive of {len(self)} files>"
+
+    @classmethod
+    def read(cls, path: Path) -> ArchiveFiles:
+        files = [path, *sorted((path.parent / f"{path.name}.d").iterdir())]
+        return cls({str(f.relative_to(path.parent)): ArchiveBytes(f.read_bytes()) for f in files})
+
+    def write(self, directory: str | Path, damaged: str = "", data: bytes = b"") -> Path:
+        """Write the archive into ``directory``, the file ``damaged`` holding ``data``."""
+        (Path(directory) / "a.h5.d").mkdir(parents=True)
+        for name, content in self.items():
+            (Path(directory) / name).write_bytes(data if name == damaged else content)
+        return Path(directory) / "a.h5"
 
 
 @pytest.fixture(scope="module")
-def archive_bytes() -> bytes:
+def archive_files() -> ArchiveFiles:
     with tempfile.TemporaryDirectory() as directory:
         path = Path(directory) / "a.h5"
         study = pi.Study.grid(
             "f", ["2024-T3/3.18"], [0, 60], np.linspace(200, 900, 4), pi.Variant("v")
         )
         study.run(archive=path, craters=True)
-        return ArchiveBytes(path.read_bytes())
+        return ArchiveFiles.read(path)
 
 
-def check_archive(data: bytes) -> None:
+def check_archive(files: ArchiveFiles, damaged: str, data: bytes) -> None:
     with tempfile.TemporaryDirectory() as directory:
-        path = Path(directory) / "damaged.h5"
-        path.write_bytes(data)
+        path = files.write(directory, damaged, data)
         assert_clean(*run_cli(["show", str(path)]))
         code, err = run_cli(["compare", str(path), "v", "v"])
         assert_clean(code, err)
@@ -95,41 +114,53 @@ def check_archive(data: bytes) -> None:
             pass
 
 
-@given(cut=st.floats(0.0, 1.0))
-def test_truncated_archives_give_one_line_errors(archive_bytes, cut):
-    check_archive(archive_bytes[: int(cut * len(archive_bytes))])
+#: Which of the archive's files is damaged: the index, the study's scenes, the run.
+WHICH = st.integers(0, 2)
 
 
-@given(flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=8))
-def test_bit_flipped_archives_give_one_line_errors(archive_bytes, flips):
-    data = bytearray(archive_bytes)
+@given(cut=st.floats(0.0, 1.0), which=WHICH)
+def test_truncated_archives_give_one_line_errors(archive_files, cut, which):
+    name = sorted(archive_files)[which]
+    data = archive_files[name]
+    check_archive(archive_files, name, data[: int(cut * len(data))])
+
+
+def flipped(data: bytes, flips: list[tuple[float, int]]) -> bytes:
+    damaged = bytearray(data)
     for where, mask in flips:
-        data[min(int(where * len(data)), len(data) - 1)] ^= mask
-    check_archive(bytes(data))
+        damaged[min(int(where * len(damaged)), len(damaged) - 1)] ^= mask
+    return bytes(damaged)
+
+
+FLIPS = st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=8)
+
+
+@given(flips=FLIPS, which=WHICH)
+def test_bit_flipped_archives_give_one_line_errors(archive_files, flips, which):
+    name = sorted(archive_files)[which]
+    check_archive(archive_files, name, flipped(archive_files[name], flips))
 
 
 @pytest.fixture(scope="module")
-def limits_archive_bytes(archive_bytes) -> bytes:
-    """The archive of ``archive_bytes`` with stored limits beside its study."""
+def limits_archive_files(archive_files) -> ArchiveFiles:
+    """The archive of ``archive_files`` with stored limits beside its study."""
     with tempfile.TemporaryDirectory() as directory:
-        path = Path(directory) / "a.h5"
-        path.write_bytes(archive_bytes)
+        path = archive_files.write(directory)
         found = limits.along_speed(
             pi.Simulation.from_names(), presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18"),
             [0.0, 0.5], (100.0, 900.0), resolution=50.0,
         )  # fmt: skip
         limits.archive_limits(path, "l", found)
-        return ArchiveBytes(path.read_bytes())
+        return ArchiveFiles.read(path)
 
 
-@given(flips=st.lists(st.tuples(st.floats(0.0, 1.0), st.integers(1, 255)), min_size=1, max_size=8))
-def test_bit_flipped_archives_with_limits_give_one_line_errors(limits_archive_bytes, flips):
-    data = bytearray(limits_archive_bytes)
-    for where, mask in flips:
-        data[min(int(where * len(data)), len(data) - 1)] ^= mask
+@given(flips=FLIPS, index=st.booleans())
+def test_bit_flipped_archives_with_limits_give_one_line_errors(limits_archive_files, flips, index):
+    name = "a.h5" if index else next(n for n in limits_archive_files if "/limits." in n)
     with tempfile.TemporaryDirectory() as directory:
-        path = Path(directory) / "damaged.h5"
-        path.write_bytes(bytes(data))
+        path = limits_archive_files.write(
+            directory, name, flipped(limits_archive_files[name], flips)
+        )
         for argv in (["show"], ["compare", "l", "l"], ["compare", "l", "l", "--json"]):
             assert_clean(*run_cli([argv[0], str(path), *argv[1:]]))
         try:  # the Python API raises ArchiveError (or reads the limits back whole)
@@ -151,7 +182,7 @@ def test_a_refused_run_writes_nothing(tmp_path):
     shutil.rmtree(tmp_path / "missing", ignore_errors=True)
 
 
-def test_damaged_archive_structure_gives_archive_error(archive_bytes, tmp_path):
+def test_damaged_archive_structure_gives_archive_error(archive_files, tmp_path):
     """Found by the bit-flip fuzz: a flipped byte in the superblock's addresses made h5py
     raise RuntimeError ("addr overflow") while listing the runs, which escaped as a
     traceback. Every h5py error inside an open archive is now an ArchiveError.
@@ -160,30 +191,31 @@ def test_damaged_archive_structure_gives_archive_error(archive_bytes, tmp_path):
     the same when the archive's size changes: byte 17 of a version-0 superblock is the
     high byte of the group B-tree's leaf K, which sends the group listing out of the
     file."""
-    data = bytearray(archive_bytes)
+    data = bytearray(archive_files["a.h5"])
     assert data[8] == 0  # superblock version 0
     data[17] ^= 11
-    path = tmp_path / "damaged.h5"
-    path.write_bytes(bytes(data))
+    path = archive_files.write(tmp_path, "a.h5", bytes(data))
     code, err = run_cli(["show", str(path)])
     assert code == 2 and len(err.strip().splitlines()) == 1 and "damaged" in err
     with pytest.raises(pi.ArchiveError):
         pi.StudyResults.from_archive(path)
 
 
-def test_damaged_run_attributes_give_archive_error(archive_bytes, tmp_path):
+def test_damaged_run_attributes_give_archive_error(archive_files, tmp_path):
     """Found by the bit-flip fuzz: attributes carry no fletcher32 checksum, so a flipped
     byte in a run's JSON metadata escaped as a JSONDecodeError or a KeyError in `show`.
     Studies and runs now carry a digest of their attributes, checked on reading."""
-    assert archive_bytes.count(b"integrator_version") == 1  # in the run's model attribute
-    path = tmp_path / "damaged.h5"
-    path.write_bytes(archive_bytes.replace(b"integrator_version", b"integrator_versioX"))
+    run = next(name for name in archive_files if ".v." in name)
+    assert archive_files[run].count(b"integrator_version") == 1  # in the run's model attribute
+    changed = archive_files[run].replace(b"integrator_version", b"integrator_versioX")
+    path = archive_files.write(tmp_path, run, changed)
     code, err = run_cli(["show", str(path)])
     assert code == 2 and len(err.strip().splitlines()) == 1 and "attributes" in err
     with pytest.raises(pi.ArchiveError, match="digest"):
         pi.Archive(path).metadata("v")
-    labels = archive_bytes.replace(b'["2024-T3/3.18"]', b'["2024-T3/3.19"]')
-    path.write_bytes(labels)
+    labels = archive_files["a.h5"].replace(b'["2024-T3/3.18"]', b'["2024-T3/3.19"]')
+    assert labels != archive_files["a.h5"]  # in the study's attributes in the index
+    path = archive_files.write(tmp_path / "labels", "a.h5", labels)
     with pytest.raises(pi.ArchiveError, match="digest"):
         pi.Archive(path).study()
 

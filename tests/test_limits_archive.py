@@ -109,8 +109,8 @@ def test_a_name_taken_gets_the_next_number_and_studies_are_untouched(tmp_path, p
     archive = pi.Archive(path)
     assert archive.studies() == ["w"] and archive.runs() == ["w/v"]
     assert pi.Study.from_archive(path).name == "w"  # the only study, limits beside it
-    tiny_study().run(archive=path)  # runs still append
-    assert archive.runs() == ["w/v", "w/v.2"] and limits.stored_limits(path) == names
+    tiny_study().run(archive=path, run_names={"v": "v2"})  # runs still append
+    assert archive.runs() == ["w/v", "w/v2"] and limits.stored_limits(path) == names
 
 
 def test_names_that_would_not_survive_or_would_be_misread_are_refused(tmp_path, plugging):
@@ -174,9 +174,15 @@ def test_damaged_attributes_are_an_archive_error(tmp_path, plugging, damage, mes
 def test_damaged_data_is_an_archive_error(tmp_path, plugging):
     path = tmp_path / "a.h5"
     limits.archive_limits(path, "plugging", plugging)
-    flip_bytes(path, "limits/plugging/boundaries/low")
+    flip_bytes(record_file(path, "plugging"), "boundaries/low")
     with pytest.raises(pi.ArchiveError, match="damaged"):
         limits.read_limits(path, "plugging")
+
+
+def record_file(path, name):
+    """The data file of the stored record ``name`` (h5py alone: the index's link)."""
+    with h5py.File(path, "r") as f:
+        return path.parent / f["limits"].get(name, getlink=True).filename
 
 
 CRASHES_HDF5 = b"long_name\x00\x00\x00\x00\x00\x00\x00\x19\x01"
@@ -190,9 +196,10 @@ def test_a_dataset_attribute_that_crashes_hdf5_is_never_read(tmp_path, plugging)
     subprocesses, so that a crash fails the test instead of ending pytest."""
     path = tmp_path / "a.h5"
     limits.archive_limits(path, "plugging", plugging)
-    data = path.read_bytes()
+    data = record_file(path, "plugging").read_bytes()
     assert data.count(CRASHES_HDF5) > 10  # every dataset's long_name, as h5py lays it out
-    path.write_bytes(data.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05"))
+    damaged = data.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05")
+    record_file(path, "plugging").write_bytes(damaged)
     plain = (
         "import h5py, sys; "
         "h5py.File(sys.argv[1])['limits/plugging/sphere/radius'].attrs['long_name']"
@@ -219,9 +226,10 @@ def test_the_file_reads_in_plain_h5py_with_units_everywhere(tmp_path, plugging, 
     limits.archive_limits(path, "map", outcome_map)
     datasets: list[h5py.Dataset] = []
     with h5py.File(path, "r") as f:  # no project code from here on
-        f["limits"].visititems(
-            lambda _, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None
-        )
+        for name in f["limits"]:  # each an external link to the record's own file
+            f["limits"][name].visititems(
+                lambda _, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None
+            )
         assert len(datasets) > 30
         for ds in datasets:
             assert {"units", "long_name", "description"} <= set(ds.attrs), ds.name

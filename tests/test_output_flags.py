@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import errno
 import os
+import shutil
 import stat
 from pathlib import Path
 
@@ -115,6 +116,7 @@ def test_a_read_only_directory_is_one_line_before_any_work(tmp_path):
 def test_an_unreadable_archive_is_read_by_root_and_one_line_for_others(tmp_path, archive):
     path = tmp_path / "closed.h5"
     path.write_bytes(archive.read_bytes())
+    shutil.copytree(pi.Archive(archive).data, tmp_path / "closed.h5.d")  # its data, renamed
     path.chmod(0o000)
     code, out, err = run_cli(["show", str(path)])
     if os.access(path, os.R_OK):  # root reads any file: the right result is the listing

@@ -7,6 +7,7 @@ import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from concurrent.futures import Executor
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -23,7 +24,11 @@ from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError
 from .storage.provenance import RunMetadata
+from .storage.reruns import plan_runs
 from .variant import Variant, check_name
+
+if TYPE_CHECKING:
+    import xarray
 
 
 def _variants(value: Iterable[Variant] | Variant) -> tuple[Variant, ...]:
@@ -158,6 +163,21 @@ class Study:
             f"study {self.name!r} has no variant {name!r}; choose from: {choices}"
         )
 
+    def check_archive(
+        self,
+        archive: str | Path | Archive,
+        *,
+        resume: bool = False,
+        overwrite: bool = False,
+        run_names: Mapping[str, str] | None = None,
+    ) -> None:
+        """Refuse now what :meth:`run` into ``archive`` would refuse before running: an
+        archive that cannot be written, a run name that is taken (without ``resume`` or
+        ``overwrite``), a study of this name with other scenes."""
+        writer = archive if isinstance(archive, Archive) else Archive(archive)
+        writer.check_writable(self.name)
+        plan_runs(writer, self, run_names, resume, overwrite)
+
     def run(
         self,
         *,
@@ -167,6 +187,8 @@ class Study:
         record_trajectory: bool = False,
         craters: bool = False,
         resume: bool = False,
+        overwrite: bool = False,
+        run_names: Mapping[str, str] | None = None,
         progress: bool | None = None,
         registry: PluginRegistry | None = None,
     ) -> StudyResults:
@@ -191,6 +213,12 @@ class Study:
             (same plug-ins and settings, same scenes, with the trajectories or craters
             asked for) is read back instead of run again. Runs are archived only when
             finished, so an interrupted run is simply absent.
+        overwrite : bool
+            Replace the stored runs of the study's variants (each atomically, when its
+            new run is finished). Without ``resume`` or ``overwrite`` a run name that
+            is taken is refused before anything runs (``RunExistsError``).
+        run_names : mapping, optional
+            Store a variant's run under another name (variant name -> run name).
         progress : bool or None
             Progress bar on stderr; None shows it on a terminal only.
         """
@@ -198,9 +226,8 @@ class Study:
         writer = archive if isinstance(archive, Archive) or archive is None else Archive(archive)
         if writer is not None:
             writer.check_writable(self.name)
-        if resume and writer is None:
-            raise ParameterError("resume", "resume=True needs the archive to resume from")
-        finished = writer.finished_runs(self) if writer is not None and resume else {}
+        planned = plan_runs(writer, self, run_names, resume, overwrite)
+        finished = {v: p.kept for v, p in planned.items() if p.kept is not None}
         simulations = {
             v.name: v.simulation(registry) for v in self.variants if v.name not in finished
         }
@@ -216,7 +243,7 @@ class Study:
                     lacks = (craters and kept.craters is None) or (
                         record_trajectory and kept.trajectory is None
                     )
-                    if not lacks:  # else run it again, keeping what was asked for
+                    if not lacks:  # else run it again (replacing it), keeping what was asked for
                         runs[variant.name] = kept
                         bar.update(self.scenes.size)
                         continue
@@ -244,9 +271,11 @@ class Study:
                 runs[variant.name] = result
                 if writer is not None:
                     try:
+                        plan = planned[variant.name]
                         writer.append_run(
-                            self, variant, result, metadata.as_attributes(), constants
-                        )
+                            self, variant, result, metadata.as_attributes(), constants,
+                            run=plan.run, overwrite=plan.replace or plan.kept is not None,
+                        )  # fmt: skip
                     except ArchiveBusyError as exc:  # the run was saved aside: say where
                         warnings.warn(str(exc), ArchiveWaitWarning, stacklevel=2)
         return StudyResults(self, runs)
@@ -310,6 +339,14 @@ class StudyResults:
             if r.split("/", 1)[0] == definition.name
         }
         return cls(definition, runs)
+
+    def to_xarray(self) -> xarray.Dataset:
+        """A grid study's runs as one xarray Dataset over (variant, plate,
+        impact_obliquity, impact_speed), SI with CF ``units``; ParameterError if the
+        scenes are not one full grid (plateimpact.export.study_cube)."""
+        from .export import study_cube  # noqa: PLC0415 (xarray only when asked for)
+
+        return study_cube(self.study, self.runs)
 
     def __getitem__(self, name: str) -> BatchResult:
         try:

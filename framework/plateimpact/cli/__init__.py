@@ -17,7 +17,14 @@ from collections.abc import Sequence
 from ..errors import ParameterError, PlateImpactError, PluginError
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..storage.provenance import versions
-from . import archive_commands, calibrate, info, limits_commands, scene_commands
+from . import (
+    archive_commands,
+    calibrate,
+    info,
+    limits_commands,
+    review_commands,
+    scene_commands,
+)
 from .common import Parser, UsageError
 from .options import flag_of
 from .reporting import one_line_warnings, report_internal_error
@@ -52,6 +59,7 @@ def build_parser(registry: PluginRegistry | None = None) -> argparse.ArgumentPar
     except argparse.ArgumentError as exc:  # a plug-in's flag is one of the command's own
         raise PluginError(_flag_taken(registry, str(exc).rsplit(": ", 1)[-1])) from None
     archive_commands.add_parsers(sub)
+    review_commands.add_parsers(sub)
     return parser
 
 

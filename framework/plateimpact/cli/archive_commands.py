@@ -20,6 +20,7 @@ from ..discovery import (
 )
 from ..errors import PluginError
 from ..results import BatchResult, Outcome
+from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
 from .common import UsageError, check_directory
@@ -29,11 +30,18 @@ from .stored_limits import compare_stored, kinds, show_stored
 def add_parsers(sub: Any) -> None:
     p = sub.add_parser("reproduce", help="run the report's figure families into one archive")
     p.add_argument("--out", default="report", help="output directory, created (default: report)")
-    p.add_argument(
+    rerun = p.add_mutually_exclusive_group()
+    rerun.add_argument(
         "--resume",
         action="store_true",
         help="keep the runs already in DIR/report.h5 and run only the missing ones "
-        "(default: add every run again, as NAME.2, ...)",
+        "(without --resume, --overwrite or --as, runs already there are refused)",
+    )
+    rerun.add_argument(
+        "--overwrite", action="store_true", help="replace the runs already there (atomically)"
+    )
+    rerun.add_argument(
+        "--as", dest="tag", metavar="TAG", help="store the new runs as VARIANT@TAG beside the old"
     )
     p.set_defaults(command_function=reproduce_command)
 
@@ -122,10 +130,22 @@ def reproduce_command(args: argparse.Namespace) -> None:
         raise UsageError(f"--out: {args.out!r} exists and is not a directory")
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
-    archive, figures = reproduce(out, resume=args.resume)
+    if args.tag is not None and not _printable_tag(args.tag):
+        raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
+    try:
+        archive, figures = reproduce(out, None, args.resume, args.overwrite, args.tag)
+    except RunExistsError as exc:
+        raise UsageError(
+            f"{str(exc).split(':', 1)[0]}: --resume keeps it (runs only what is missing), "
+            "--overwrite replaces it, --as TAG stores the new runs as VARIANT@TAG"
+        ) from None
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")
+
+
+def _printable_tag(tag: str) -> bool:
+    return bool(tag) and tag.isprintable() and "/" not in tag and not any(c.isspace() for c in tag)
 
 
 def _study_results(archive: Archive, runs: list[str]) -> StudyResults:

@@ -226,16 +226,21 @@ def _archive(archive: Archive | str | os.PathLike[str]) -> Archive:
 
 
 def archive_limits(
-    archive: Archive | str | os.PathLike[str], name: str, found: Limits | OutcomeMap
+    archive: Archive | str | os.PathLike[str],
+    name: str,
+    found: Limits | OutcomeMap,
+    *,
+    overwrite: bool = False,
 ) -> str:
     """Store ``found`` (limits or an outcome map) in ``archive`` as ``/limits/NAME``
-    (``NAME.2``, ``NAME.3``, ... if the name is taken), atomically and under the
-    archive's lock as runs are added; returns the name it was stored under."""
+    (``NAME.2``, ``NAME.3``, ... if the name is taken; with ``overwrite``, in its
+    place), atomically and under the archive's lock as runs are added; returns the name
+    it was stored under."""
     if not isinstance(found, Limits | OutcomeMap):
         raise ParameterError(
             "found", f"found must be Limits or an OutcomeMap, got {type(found).__name__}"
         )
-    return _archive(archive).append_record(name, to_record(found))
+    return _archive(archive).append_record(name, to_record(found), overwrite=overwrite)
 
 
 def read_limits(archive: Archive | str | os.PathLike[str], name: str) -> Limits | OutcomeMap:

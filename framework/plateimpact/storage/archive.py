@@ -1,40 +1,45 @@
 """HDF5 archives of study runs (schema: docs/archive.md).
 
-One file holds any number of studies; each study holds its scenes once and any number
-of runs. A run is appended by copying the archive to a temporary file, adding the run
-there and renaming the copy over the original (``os.replace``), so a crash at any point
-leaves the previous archive, with every finished run, untouched (storage.append). One
-writer at a time per real file, across threads and processes (storage.lock); readers
-never wait, since the file they open is always a whole one. A symlinked archive is
+An archive is an index file (``ARCHIVE``, HDF5) that names its studies, runs and stored
+limits, and a directory of data files beside it (``ARCHIVE.d``): one netCDF-4 file per
+run, per study's scenes and per stored record, each written once and never changed, so
+that xarray, h5py or any netCDF tool reads a run as it is. Appending writes the run's
+file and then replaces the index atomically (storage.append), so a crash at any point
+leaves the previous archive, with every finished run, untouched, and an append costs
+the same whatever the number of runs already there. One writer at a time per real file,
+across threads and processes (storage.lock); readers never wait, since the index they
+open is always a whole one and names only complete data files. A symlinked archive is
 followed: its target is written and locked, and keeps its mode, owner and group.
-Stored limits and maps (storage.records, under ``/limits``) are appended the same way.
+Format-1 archives (one file holding everything) are read; appends go to format 2.
 """
 
 from __future__ import annotations
 
-import contextlib
 import datetime as dt
 import json
 import os
 import stat
-from collections.abc import Callable, Iterator, Sequence
-from pathlib import Path
+from collections.abc import Callable
+from pathlib import Path, PurePath
 
 import attrs
 import h5py
-import numpy as np
 
 from ..batch import SceneBatch
-from ..errors import ArchiveError, PlateImpactError, UnknownNameError
+from ..errors import ArchiveError, UnknownNameError
 from ..parameters import Parameter
-from ..ragged import Ragged
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from ..variant import Variant
 from . import append as append_module
 from . import records
-from .append import FORMAT, FORMAT_VERSION, StudyDefinition, append, check_same_scenes
-from .hdf5 import SEAL, digest, plain_attributes
+from .append import (
+    FORMAT_VERSION,
+    StudyDefinition,
+    append,
+    check_same_scenes,
+)
 from .lock import ArchiveBusyError, locked
+from .reader import ArchiveFiles
 from .records import LIMITS, Record
 
 #: How long a writer waits for another one to finish with the archive [s].
@@ -53,21 +58,19 @@ class ArchivedStudy:
     description: str
 
 
-class Archive:
-    """An HDF5 archive of studies and their runs at ``path``.
+class Archive(ArchiveFiles):
+    """An HDF5 archive of studies and their runs at ``path`` (its data files in
+    ``PATH.d``).
 
     Runs are named ``STUDY/RUN``; the bare ``RUN`` is enough when one study has it.
     Every failure to open, read or write (missing directory, not HDF5, another format
-    version, checksum mismatch, read-only, busy) raises :class:`ArchiveError` with a
-    one-line message. ``wait``: how long an append waits for another writer [s].
+    version, checksum mismatch, missing data file, read-only, busy) raises
+    :class:`ArchiveError` with a one-line message. ``wait``: how long an append waits
+    for another writer [s].
     """
 
     def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
-        self.path = Path(path)
-        self.named = bool(os.fspath(path))  # Path("") is Path("."): keep what was given
-        self.real = Path(os.path.realpath(path)) if self.named else self.path
-        # (a name-less path, "" or "/", is refused by every method before the lock is used)
-        self.lock_path = self.real.parent / f"{self.real.name or 'root'}.lock"
+        super().__init__(path)
         self.wait = wait
 
     # -- writing ---------------------------------------------------------------------
@@ -84,6 +87,12 @@ class Archive:
             raise ArchiveError(f"archive {self.path}: directory {directory} does not exist")
         if not os.access(directory, os.W_OK | os.X_OK):
             raise ArchiveError(f"archive {self.path}: directory {directory} is not writable")
+        if self.data.exists() and not (
+            self.data.is_dir() and os.access(self.data, os.W_OK | os.X_OK)
+        ):
+            raise ArchiveError(
+                f"archive {self.path}: its data directory {self.data} is not a writable directory"
+            )
         if study is not None:
             records.check_study_name(study, self.path)
         if self.real.exists():
@@ -92,8 +101,14 @@ class Archive:
                 raise ArchiveError(f"archive {self.path} is not a regular file")
             if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
                 raise ArchiveError(f"archive {self.path} is read-only; refusing to append to it")
-            with self._open():  # damaged, not an archive, another version: refused now
-                pass
+            with self._open() as f:  # damaged, not an archive, another version: refused now
+                version = f.attrs.get("format_version")
+            if version != FORMAT_VERSION:
+                raise ArchiveError(
+                    f"archive {self.path} has format version {version}, which this plateimpact "
+                    f"reads but does not append to; `plateimpact upgrade {self.path}` "
+                    f"rewrites it as version {FORMAT_VERSION}"
+                )
 
     def append_run(
         self,
@@ -102,29 +117,38 @@ class Archive:
         result: BatchResult,
         attributes: dict[str, object],
         constants: dict[str, Parameter] | None = None,
+        *,
+        run: str | None = None,
+        overwrite: bool = False,
     ) -> str:
-        """Add one finished run of ``study`` (atomically); returns its name ``STUDY/RUN``.
+        """Add one finished run of ``study`` (atomically) as ``run`` (default: the
+        variant's name); returns its name ``STUDY/RUN``. A run of that name is replaced
+        with ``overwrite`` and otherwise refused (:class:`RunExistsError`).
 
         ``constants`` are the declarations of the plate constants the run's plug-ins read
-        (units and descriptions of the scene datasets). If another writer keeps the
+        (units and descriptions of the scene columns). If another writer keeps the
         archive longer than ``wait``, the run is saved to a side archive beside it and
         :class:`ArchiveBusyError` says where: a finished run is never lost."""
         self.check_writable(study.name)
-        run = self._append(
-            lambda real: append(real, study, variant, result, attributes, constants or {}),
-            lambda name: f"run {study.name}/{name}",
-            variant.name,
-            f"{study.name}.{variant.name}",
+        name = run or variant.name
+        stored = self._append(
+            lambda real: append(
+                real, study, variant, result, attributes, constants or {}, name, overwrite
+            ),
+            lambda stored: f"run {study.name}/{stored}",
+            name,
+            f"{study.name}.{name}",
         )
-        return f"{study.name}/{run}"
+        return f"{study.name}/{stored}"
 
-    def append_record(self, name: str, record: Record) -> str:
+    def append_record(self, name: str, record: Record, *, overwrite: bool = False) -> str:
         """Add ``record`` (limits or a map, as plain data) as ``/limits/NAME``, or
-        ``NAME.2``, ... (atomically, as runs are added); returns the name it took."""
+        ``NAME.2``, ... (with ``overwrite``: in the place of ``NAME``), atomically, as
+        runs are added; returns the name it took."""
         name = records.check_record_name(name)
         self.check_writable()
         return self._append(
-            lambda real: records.append_record(real, name, record, self.path),
+            lambda real: records.append_record(real, name, record, self.path, overwrite),
             lambda stored: f"{LIMITS}/{stored}",
             name,
             f"{LIMITS}.{name}",
@@ -173,78 +197,23 @@ class Archive:
         with self._open() as f:
             if study.name not in records.study_names(f):
                 return {}
-            check_same_scenes(f[study.name], study, self.path)
-            runs = f[study.name].get("runs", {})
-            found: dict[str, str] = {}
-            for name in sorted(runs, key=lambda r: _start(runs[r])):
-                recorded = Variant.from_json(str(self._check_seal(runs[name])["variant"]))
-                if recorded in study.variants and recorded.name not in found:
-                    found[recorded.name] = f"{study.name}/{name}"
-            return found
+            with self._linked(f, f"{study.name}/scenes") as scenes:
+                check_same_scenes(scenes, study, self.path)
+        found: dict[str, str] = {}
+        for run in self.runs():
+            if run.split("/", 1)[0] != study.name:
+                continue
+            recorded = Variant.from_json(str(self._attributes(run)["variant"]))
+            if recorded in study.variants and recorded.name not in found:
+                found[recorded.name] = run
+        return found
 
     # -- reading ---------------------------------------------------------------------
 
-    @contextlib.contextmanager
-    def _open(self) -> Iterator[h5py.File]:
-        if not self.named:
-            raise ArchiveError("give an archive file name, got ''")
-        if not self.real.exists():
-            raise ArchiveError(f"archive {self.path} does not exist")
-        if not self.real.is_file():
-            raise ArchiveError(f"archive {self.path} is not a file")
-        if not os.access(self.real, os.R_OK):
-            raise ArchiveError(f"archive {self.path} cannot be read: permission denied")
-        try:
-            hdf5 = h5py.is_hdf5(self.real)
-        except OSError as exc:
-            raise ArchiveError(f"archive {self.path} cannot be read: {_first_line(exc)}") from None
-        if not hdf5:
-            raise ArchiveError(f"{self.path} is not an HDF5 file")
-        try:
-            f = h5py.File(self.real, "r")
-        except OSError as exc:
-            raise ArchiveError(
-                f"archive {self.path} cannot be opened: {_first_line(exc)}"
-            ) from None
-        with f:
-            try:
-                if f.attrs.get("format") != FORMAT:
-                    raise ArchiveError(f"{self.path} is an HDF5 file but not a plateimpact archive")
-                version = f.attrs.get("format_version")
-                if version != FORMAT_VERSION:
-                    raise ArchiveError(
-                        f"archive {self.path} has format version {version}; this plateimpact "
-                        f"reads and writes version {FORMAT_VERSION}"
-                    )
-                yield f
-            except PlateImpactError:
-                raise
-            except (OSError, RuntimeError, KeyError, ValueError, TypeError) as exc:
-                # Damaged structure (not just damaged data, which the checksums catch):
-                # h5py raises any of these from a corrupt header, link or attribute.
-                raise ArchiveError(f"archive {self.path} is damaged: {_first_line(exc)}") from None
-
-    def _read(self, f: h5py.File, path: str) -> np.ndarray:
-        try:
-            return np.asarray(f[path][()])
-        except (OSError, KeyError, ValueError, MemoryError) as exc:  # memory: a damaged shape
-            raise ArchiveError(
-                f"archive {self.path}: {path} cannot be read ({_first_line(exc)}); "
-                "the file is damaged"
-            ) from None
-
-    def _read_ragged(
-        self, f: h5py.File, path: str, counts: str, per_row: Sequence[str], first: Sequence[str]
-    ) -> Ragged:
-        """A ragged array, its columns in the order ``first`` names them, then the rest."""
-        stored = [k for k in f[path] if k != counts]
-        names = [k for k in first if k in stored] + [k for k in stored if k not in first]
-        values = {k: self._read(f, f"{path}/{k}") for k in names if k not in per_row}
-        rows = {k: self._read(f, f"{path}/{k}") for k in names if k in per_row}
-        try:
-            return Ragged(self._read(f, f"{path}/{counts}"), values, rows)
-        except ValueError as exc:
-            raise ArchiveError(f"archive {self.path}: {path} is damaged ({exc})") from None
+    def version(self) -> int:
+        """The archive's format version."""
+        with self._open() as f:
+            return int(f.attrs["format_version"])
 
     def studies(self) -> list[str]:
         with self._open() as f:
@@ -253,6 +222,12 @@ class Archive:
     def runs(self) -> list[str]:
         """Every run as ``STUDY/RUN``, in the order written."""
         with self._open() as f:
+            if f.attrs["format_version"] != 1:  # links kept in the order made
+                return [
+                    f"{study}/{run}"
+                    for study in records.study_names(f)
+                    for run in f[study].get("runs", {})
+                ]
             return [
                 f"{study}/{run}"
                 for study in records.study_names(f)
@@ -272,27 +247,37 @@ class Archive:
         hint = "ambiguous; " if matches else ""
         raise UnknownNameError(f"no run {run!r} in {self.path} ({hint}runs: {', '.join(runs)})")
 
+    def data_file(self, run: str) -> Path | None:
+        """The run's own netCDF file (format 2), which xarray opens as it is; None for a
+        format-1 archive, whose runs live in the archive file itself."""
+        study, name = self.resolve(run).split("/", 1)
+        with self._open() as f:
+            link = f.get(f"{study}/runs/{name}", getlink=True)
+        if not isinstance(link, h5py.ExternalLink):
+            return None
+        return self.data / PurePath(link.filename).name
+
     def study(self, name: str | None = None) -> ArchivedStudy:
         """The study as it was defined (scenes, variants, labels, description)."""
         with self._open() as f:
             name = self._study_name(f, name)
             group = f[name]
             self._check_seal(group)
-            columns = {
-                k: self._read(f, f"{name}/scenes/{k}")
-                for k in group["scenes"]
-                if k != "plate_label"
-            }
             labels = json.loads(group.attrs["plate_labels"])
-            index = self._read(f, f"{name}/scenes/plate_label")
             variants = tuple(Variant(**v) for v in json.loads(group.attrs["variants"]))
-            return ArchivedStudy(
-                name,
-                SceneBatch(columns),
-                variants,
-                tuple(labels[i] for i in index),
-                str(group.attrs["description"]),
-            )
+            description = str(group.attrs["description"])
+            with self._linked(f, f"{name}/scenes") as scenes:
+                columns = {
+                    k: self._read(scenes, k)
+                    for k in scenes
+                    if k not in ("plate_label", "plate", "scene")
+                }
+                if "plate" in scenes:  # format 2: the label of each scene
+                    per_scene = tuple(str(x) for x in scenes["plate"].asstr()[()])
+                else:
+                    index = self._read(scenes, "plate_label")
+                    per_scene = tuple(labels[i] for i in index)
+            return ArchivedStudy(name, SceneBatch(columns), variants, per_scene, description)
 
     def _study_name(self, f: h5py.File, name: str | None) -> str:
         studies = records.study_names(f)
@@ -306,50 +291,48 @@ class Archive:
             )
         return name
 
+    def _attributes(self, run: str) -> dict[str, object]:
+        with self._open() as f, self._linked(f, _run_path(run)) as group:
+            return self._check_seal(group)
+
+    def raw_attributes(self, run: str) -> dict[str, object]:
+        """The run's attributes as stored (JSON as text), their digest checked."""
+        return self._attributes(self.resolve(run))
+
     def metadata(self, run: str) -> dict[str, object]:
-        run = self.resolve(run)
-        with self._open() as f:
-            attributes = self._check_seal(f[_run_path(run)])
+        """What the run records of how it was made (variant, model, versions, commit,
+        host, times), JSON decoded; the same keys in either format version."""
+        attributes = self._attributes(self.resolve(run))
         out: dict[str, object] = {}
         for key, value in attributes.items():
+            if key in ("Conventions", "study", "run"):  # a data file's own labels
+                continue
             if key in ("variant", "model", "versions", "failure_state_units"):
                 value = json.loads(str(value))
             out[key] = value
         return out
 
-    def _check_seal(self, group: h5py.Group) -> dict[str, object]:
-        """The group's attributes, after checking them against their digest (attributes
-        have no fletcher32 checksum of their own)."""
-        attributes = plain_attributes(group)
-        sealed = attributes.pop(SEAL, None)
-        if sealed is None:
-            raise ArchiveError(
-                f"archive {self.path}: the attributes of {group.name} are damaged "
-                "(their digest is missing)"
-            )
-        if sealed != digest(attributes):
-            raise ArchiveError(
-                f"archive {self.path}: the attributes of {group.name} are damaged "
-                "(their digest does not match)"
-            )
-        return attributes
-
     def results(self, run: str) -> BatchResult:
         """The run's results, bit for bit as they were computed."""
         run = self.resolve(run)
-        base = _run_path(run)
         with self._open() as f:
-            columns = {k: self._read(f, f"{base}/results/{k}") for k in RESULT_FIELDS}
-            craters = trajectory = None
-            if "crater" in f[base]:
-                path = f"{base}/crater"
-                craters = self._read_ragged(
-                    f, path, "counts", ["impact_point"], list(CRATER_FIELDS)
-                )
-            if "trajectory" in f[base]:
-                path = f"{base}/trajectory"
-                trajectory = self._read_ragged(f, path, "count", [], list(TRAJECTORY_FIELDS))
-            return BatchResult(columns, trajectory, craters=craters)
+            one = f.attrs["format_version"] == 1
+            with self._linked(f, _run_path(run)) as group:
+                prefix = "results/" if one else ""
+                columns = {k: self._read(group, prefix + k) for k in RESULT_FIELDS}
+                columns["plate_failed"] = columns["plate_failed"].astype(bool)
+                crater, path = ("crater/", "counts") if one else ("crater_", "count")
+                craters = trajectory = None
+                if crater + path in group:
+                    craters = self._read_ragged(
+                        group, crater, path, ["impact_point"], list(CRATER_FIELDS)
+                    )
+                moves = "trajectory/" if one else "trajectory_"
+                if moves + "count" in group:
+                    trajectory = self._read_ragged(
+                        group, moves, "count", [], list(TRAJECTORY_FIELDS)
+                    )
+                return BatchResult(columns, trajectory, craters=craters)
 
     # -- stored limits and maps ----------------------------------------------------------
 
@@ -371,9 +354,10 @@ class Archive:
                     f"(stored: {', '.join(names) or 'none'})"
                 )
             self._check_seal(f[LIMITS])
-            return records.read_record(
-                f[f"{LIMITS}/{name}"], self._check_seal, lambda path: self._read(f, path)
-            )
+            with self._linked(f, f"{LIMITS}/{name}") as group:
+                return records.read_record(
+                    group, self._check_seal, lambda path: self._read(group.file, path)
+                )
 
 
 def _run_path(run: str) -> str:
@@ -383,8 +367,3 @@ def _run_path(run: str) -> str:
 
 def _start(group: h5py.Group) -> str:
     return str(group.attrs.get("start_time", ""))
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()
-    return text[0] if text else type(exc).__name__

@@ -47,7 +47,14 @@ def write_declared(group: h5py.Group, declared: Parameter, data: np.ndarray) -> 
 
 
 def plain_attributes(group: h5py.Group) -> dict[str, object]:
-    return {k: v.item() if isinstance(v, np.generic) else v for k, v in group.attrs.items()}
+    """The group's attributes as Python values, without netCDF's own (``_NCProperties``,
+    which the netCDF library may write or rewrite). netCDF stores a number as an array of
+    one; it reads back as the number."""
+    return {
+        k: v.item() if isinstance(v, np.generic) or np.ndim(v) == 1 and np.size(v) == 1 else v
+        for k, v in group.attrs.items()
+        if not k.startswith("_")
+    }
 
 
 def digest(attributes: dict[str, object]) -> str:

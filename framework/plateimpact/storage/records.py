@@ -4,8 +4,9 @@
 A record is plain data, so that storage needs nothing of what it holds: sealed
 attributes (strings and numbers) and datasets, each with its SI ``units``, a
 ``long_name`` and a ``description``. Records live under the top-level group ``/limits``,
-one group each, ``/limits/NAME``; a name already there gets ``.2``, ``.3``, ... as runs
-do. The study name ``limits`` is therefore reserved.
+one entry each, ``/limits/NAME`` (format 2: a link to the record's own data file, as
+runs are); a name already there gets ``.2``, ``.3``, ..., and the name it took is
+returned and printed. The study name ``limits`` is therefore reserved.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import h5py
 import numpy as np
 
 from ..errors import ArchiveError, ParameterError
-from .append import append_with
+from .append import DataFiles, append_with
 from .hdf5 import seal, write_dataset
 
 #: The top-level group of the stored records; a study may not take its name.
@@ -84,48 +85,69 @@ def check_record_name(name: object) -> str:
     return text
 
 
-def write_record(f: h5py.File, name: str, record: Record, path: Path) -> str:
-    """Add ``record`` to the open archive ``f`` as ``/limits/NAME`` (``NAME.2``, ... if
-    taken); returns the name it was stored under."""
+def write_record(
+    f: h5py.File, files: DataFiles, name: str, record: Record, path: Path, overwrite: bool = False
+) -> str:
+    """Add ``record`` to the index ``f`` as ``/limits/NAME`` (``NAME.2``, ... if taken;
+    with ``overwrite`` it replaces ``NAME``), its data in a file of its own; returns the
+    name it was stored under."""
     if LIMITS in f and not is_container(f, LIMITS):
         raise ArchiveError(
             f"archive {path} holds a study named {LIMITS!r}, where limits are stored; "
             "store them in another archive"
         )
     if LIMITS not in f:
-        container = f.create_group(LIMITS)
+        container = f.create_group(LIMITS, track_order=True)
         container.attrs["description"] = (
-            "stored limits and outcome maps, one group each; see docs/archive.md"
+            "stored limits and outcome maps, one entry each; see docs/archive.md"
         )
         seal(container)
     container = f[LIMITS]
     stored, k = name, 1
+    if overwrite and name in container:
+        old = container.get(name, getlink=True)
+        if isinstance(old, h5py.ExternalLink):
+            files.retire(old.filename)
+        del container[name]
     while stored in container:
         k += 1
         stored = f"{name}.{k}"
-    group = container.create_group(stored)
-    for key, value in record.attributes.items():
-        group.attrs[key] = value
-    seal(group)
-    for where, column in record.columns.items():
-        parent, _, leaf = where.rpartition("/")
-        target = group.require_group(parent) if parent else group
-        write_dataset(target, leaf, column.data, column.units, column.description, column.long_name)
+    target = files.new(f"{LIMITS}.{stored}", lambda where: write_record_file(where, record))
+    container[stored] = h5py.ExternalLink(target, "/")
     return stored
 
 
-def append_record(real: Path, name: str, record: Record, path: Path) -> str:
-    """Add ``record`` to the archive file ``real`` through the atomic append
-    (storage.append: copy, extend, replace, each stage a fault point); ``path`` as the
-    user named the archive, for messages. The caller holds the lock."""
-    return append_with(real, lambda f: write_record(f, name, record, path))
+def write_record_file(where: Path, record: Record) -> None:
+    """The record's own HDF5 file: sealed attributes at its root, then its datasets."""
+    with h5py.File(where, "w") as group:
+        for key, value in record.attributes.items():
+            group.attrs[key] = value
+        seal(group)
+        for at, column in record.columns.items():
+            parent, _, leaf = at.rpartition("/")
+            target = group.require_group(parent) if parent else group
+            write_dataset(
+                target, leaf, column.data, column.units, column.description, column.long_name
+            )
+
+
+def append_record(
+    real: Path, name: str, record: Record, path: Path, overwrite: bool = False
+) -> str:
+    """Add ``record`` to the archive ``real`` through the atomic append (storage.append:
+    its data file, then the index copied, extended and replaced, each stage a fault
+    point); ``path`` as the user named the archive, for messages. The caller holds the
+    lock."""
+    return append_with(real, lambda f, files: write_record(f, files, name, record, path, overwrite))
 
 
 def record_names(f: h5py.File) -> list[str]:
-    """The records of the open archive ``f``, in the order written."""
+    """The records of the open index ``f``, in the order written."""
     if LIMITS not in f or not is_container(f, LIMITS):
         return []
     group = f[LIMITS]
+    if f.attrs.get("format_version") != 1:
+        return list(group)  # links kept in the order made
     return sorted(group, key=lambda name: str(group[name].attrs.get("creation_time", "")))
 
 

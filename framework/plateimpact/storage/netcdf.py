@@ -1,0 +1,163 @@
+"""The data files of a format-2 archive: one netCDF-4 file per run and per study's scenes
+(docs/archive.md). xarray opens a run file as it is, with no project code:
+
+    xarray.open_dataset(run_file, engine="h5netcdf")
+
+gives one Dataset whose variables share the dimension ``scene``, with the scene's
+parameters (impact speed, obliquity, sphere, plate label and constants) as coordinates,
+CF ``units``/``long_name`` on every variable and ``flag_values``/``flag_meanings`` on the
+outcome. Trajectories and crater sections are CF contiguous ragged arrays
+(``trajectory_count`` with ``sample_dimension = "trajectory_sample"``; ``crater_count``
+with ``"crater_point"``). Every dataset is fletcher32-checksummed; the file's global
+attributes are sealed by their SHA-256 as in format 1.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import h5py
+import numpy as np
+
+from ..parameters import Parameter
+from ..ragged import Ragged
+from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from .hdf5 import digest
+
+SCENE, SAMPLE, POINT = "scene", "trajectory_sample", "crater_point"
+#: The per-scene label of the plate, a string coordinate.
+PLATE = Parameter("plate", "the plate's label (a preset name, or the study's own)", kind=str)
+#: CF flags of the integer-coded results.
+FLAGS: dict[str, tuple[list[int], str]] = {
+    "outcome": ([int(o) for o in Outcome], " ".join(o.label for o in Outcome)),
+    "plate_failed": ([0, 1], "intact failed"),
+}
+CONVENTIONS = "CF-1.11"
+
+
+def long_name(declared: Parameter) -> str:
+    return declared.name.replace("_", " ")
+
+
+def _chunk(size: int) -> tuple[int]:
+    return (int(min(max(size, 1), 1 << 16)),)
+
+
+def _variable(
+    f: Any, name: str, dims: tuple[str, ...], data: np.ndarray, declared: Parameter
+) -> Any:
+    """A checksummed variable with CF ``units``, ``long_name`` and the declared
+    ``description`` (and flags, for integer codes)."""
+    data = np.asarray(data)
+    if data.dtype == bool:
+        data = data.astype(np.int8)
+    if data.dtype.kind in "OUS":
+        variable = f.create_variable(name, dims, h5py.string_dtype(), data=data.astype(object))
+    else:
+        variable = f.create_variable(
+            name, dims, data.dtype, data=data, chunks=_chunk(data.size), fletcher32=True
+        )
+    if declared.name in FLAGS:
+        values, meanings = FLAGS[declared.name]
+        variable.attrs["flag_values"] = np.array(values, dtype=data.dtype)
+        variable.attrs["flag_meanings"] = meanings
+    if data.dtype.kind not in "OUS":
+        variable.attrs["units"] = declared.unit or "1"
+    variable.attrs["long_name"] = long_name(declared)
+    variable.attrs["description"] = declared.description
+    return variable
+
+
+def write_scenes(
+    f: Any,
+    columns: Mapping[str, np.ndarray],
+    declared: Mapping[str, Parameter],
+    plate_labels: Sequence[str],
+) -> list[str]:
+    """The ``scene`` dimension and its coordinates (every scene column [SI], then the
+    plate's label); returns the coordinates' names, for the data variables' CF
+    ``coordinates`` attribute."""
+    size = len(plate_labels)
+    f.dimensions[SCENE] = size
+    index = Parameter(SCENE, "the scene's index in its study, from 0", kind=int)
+    _variable(f, SCENE, (SCENE,), np.arange(size, dtype=np.int64), index)
+    for name, values in columns.items():
+        _variable(f, name, (SCENE,), values, declared[name])
+    _variable(f, PLATE.name, (SCENE,), np.array(list(plate_labels), dtype=object), PLATE)
+    return [*columns, PLATE.name]
+
+
+def write_ragged(
+    f: Any, prefix: str, dimension: str, ragged: Ragged, declared: Mapping[str, Parameter]
+) -> None:
+    """A CF contiguous ragged array: ``PREFIX_count`` per scene, then the columns as
+    ``PREFIX_NAME`` over ``dimension`` (per-scene ones over ``scene``)."""
+    f.dimensions[dimension] = int(ragged.counts.sum())
+    counts = Parameter(f"{prefix}_count", f"{dimension.replace('_', ' ')}s per scene, in order")
+    count = _variable(f, counts.name, (SCENE,), ragged.counts.astype(np.int64), counts)
+    count.attrs["sample_dimension"] = dimension
+    for name, values in ragged.values.items():
+        _variable(f, f"{prefix}_{name}", (dimension,), values, declared[name])
+    for name, values in ragged.per_row.items():
+        _variable(f, f"{prefix}_{name}", (SCENE,), values, declared[name])
+
+
+def trajectory_field(name: str, state_units: Mapping[str, str]) -> Parameter:
+    """The declaration of a trajectory column: a core one or ``failure_<state>``."""
+    if name in TRAJECTORY_FIELDS:
+        return TRAJECTORY_FIELDS[name]
+    state = name.removeprefix("failure_")
+    return Parameter(
+        name, f"failure-model state {state!r} (NaN before failure)", state_units.get(state, "1")
+    )
+
+
+def write_run_file(
+    path: str | os.PathLike[str],
+    columns: Mapping[str, np.ndarray],
+    declared: Mapping[str, Parameter],
+    plate_labels: Sequence[str],
+    result: BatchResult,
+    attributes: Mapping[str, object],
+) -> None:
+    """One run as a netCDF-4 file at ``path``: the scenes as coordinates, the results as
+    variables over ``scene``, the ragged arrays, and ``attributes`` (sealed)."""
+    import h5netcdf  # noqa: PLC0415 (only archives need it)
+
+    with h5netcdf.File(path, "w") as f:
+        coordinates = " ".join(write_scenes(f, columns, declared, plate_labels))
+        for name, field in RESULT_FIELDS.items():
+            variable = _variable(f, name, (SCENE,), result.columns[name], field)
+            variable.attrs["coordinates"] = coordinates
+        if result.trajectory is not None:
+            units = json.loads(str(attributes.get("failure_state_units", "{}")))
+            fields = {k: trajectory_field(k, units) for k in result.trajectory.values}
+            write_ragged(f, "trajectory", SAMPLE, result.trajectory, fields)
+        if result.craters is not None:
+            write_ragged(f, "crater", POINT, result.craters, CRATER_FIELDS)
+        seal_file(f, {"Conventions": CONVENTIONS, **attributes})
+
+
+def write_scenes_file(
+    path: str | os.PathLike[str],
+    columns: Mapping[str, np.ndarray],
+    declared: Mapping[str, Parameter],
+    plate_labels: Sequence[str],
+    attributes: Mapping[str, object],
+) -> None:
+    """A study's scenes as a netCDF-4 file: the ``scene`` coordinates only."""
+    import h5netcdf  # noqa: PLC0415
+
+    with h5netcdf.File(path, "w") as f:
+        write_scenes(f, columns, declared, plate_labels)
+        seal_file(f, {"Conventions": CONVENTIONS, **attributes})
+
+
+def seal_file(f: Any, attributes: Mapping[str, object]) -> None:
+    """Global attributes and their digest (netCDF's own ``_``-attributes aside)."""
+    for key, value in attributes.items():
+        f.attrs[key] = value
+    f.attrs["attributes_sha256"] = digest(dict(attributes))
