@@ -301,9 +301,10 @@ def test_the_readme_example_prints_ranges_in_under_40_lines(readme_archive):
             )
 
 
-def test_json_is_one_object_with_units_in_its_keys(readme_archive):
+def test_json_is_one_object_with_units_in_its_keys(readme_archive, tmp_path):
     path, results = readme_archive
-    code, out, err = run_cli(["compare", str(path), *README_RUNS, "--json"])
+    png = tmp_path / "c.png"
+    code, out, err = run_cli(["compare", str(path), *README_RUNS, "--json", "--png", str(png)])
     assert code == 0, err
     found = json.loads(out)  # the whole of stdout: one object, nothing else
     assert found["a"] == "2024-T3_3.18mm/plugging" and found["b"] == "2024-T3_3.18mm/large-pstar"
@@ -313,6 +314,7 @@ def test_json_is_one_object_with_units_in_its_keys(readme_archive):
         assert {"plate", "obliquity_deg", "from_m_s", "to_m_s", "scenes", "outcome_a",
                 "outcome_b", "max_abs_delta_exit_speed_m_s",
                 "max_abs_delta_exit_obliquity_deg"} <= set(r)  # fmt: skip
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"  # and nothing else on stdout
 
 
 def test_summary_counts_only(readme_archive):

@@ -54,7 +54,7 @@ def add_parsers(sub: Any) -> None:
     p.add_argument(
         "--png",
         metavar="FILE",
-        help="overlay plot of the two runs",
+        help="runs: their exit speeds and obliquities overlaid, outcome changes shaded",
     )
     p.add_argument(
         "--summary",
@@ -199,8 +199,9 @@ def compare_command(args: argparse.Namespace) -> None:
     print_comparison(comparison, as_json=args.json, summary=args.summary)
     if args.png:
         from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..comparison.figure import plot_comparison  # noqa: PLC0415
 
-        plotting.save(plotting.plot_study(results), args.png, "--png")
+        plotting.save(plot_comparison(comparison), args.png, "--png")
         if not args.json:
             print(f"figure: {args.png}")
 
