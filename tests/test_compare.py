@@ -301,6 +301,25 @@ def test_the_readme_example_prints_ranges_in_under_40_lines(readme_archive):
             )
 
 
+def test_the_readmes_quoted_output_is_what_compare_prints(readme_archive):
+    path, _ = readme_archive
+    readme = (ROOT / "README.md").read_text()
+    block = readme.split(
+        "$ plateimpact compare report/report.h5 2024-T3_3.18mm/plugging large-pstar\n"
+    )[-1]
+    quoted = block.split("```")[0].splitlines()
+    quoted = list(itertools.takewhile(lambda line: not line.startswith("$ "), quoted))
+    code, out, _ = run_cli(["compare", str(path), *README_RUNS])
+    lines = out.splitlines()
+    shown = [line for line in quoted if line.strip() != "..."]
+    assert f"({len(lines)} lines here" in readme
+    assert len(shown) >= 4
+    at = 0
+    for line in shown:  # each quoted line printed, in order
+        assert line in lines[at:], line
+        at = lines.index(line, at) + 1
+
+
 def test_json_is_one_object_with_units_in_its_keys(readme_archive, tmp_path):
     path, results = readme_archive
     png = tmp_path / "c.png"
@@ -314,7 +333,7 @@ def test_json_is_one_object_with_units_in_its_keys(readme_archive, tmp_path):
         assert {"plate", "obliquity_deg", "from_m_s", "to_m_s", "scenes", "outcome_a",
                 "outcome_b", "max_abs_delta_exit_speed_m_s",
                 "max_abs_delta_exit_obliquity_deg"} <= set(r)  # fmt: skip
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"  # and nothing else on stdout
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_summary_counts_only(readme_archive):
