@@ -80,7 +80,7 @@ class Spread:
     """How far B's exits differ from A's over some scenes.
 
     ``max_abs_exit_speed_change`` [m/s] (None: no scenes); ``max_abs_exit_obliquity_change``
-    [rad] over the scenes left in both runs (None: none is).
+    [rad] over the scenes where the sphere leaves the plate in both runs (None: none).
     """
 
     scenes: int
