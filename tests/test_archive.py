@@ -277,14 +277,15 @@ def test_compare_reports_the_large_pstar_outcome_changes(tmp_path, capsys):
     results = small_study().run(archive=path)
     comparison = results.compare("plugging", "large-pstar")
     plugging, intact = results["plugging"].outcome, results["large-pstar"].outcome
-    np.testing.assert_array_equal(comparison.changed, np.flatnonzero(plugging != intact))
+    failed = results["plugging"].plate_failed != results["large-pstar"].plate_failed
+    np.testing.assert_array_equal(comparison.changed, np.flatnonzero((plugging != intact) | failed))
     # A plate that never fails is never perforated, and fast impacts perforate it otherwise.
     assert not np.any(intact == pi.Outcome.PERFORATION)
-    assert comparison.summary()["transitions"]["perforation -> embedment"] > 0
+    assert comparison.summary()["changes"]["perforation -> embedment"] > 0
     assert cli(["compare", str(path), "plugging", "large-pstar"]) == 0
     out = capsys.readouterr().out
-    assert f'"outcome_changes": {comparison.changed.size}' in out
-    assert out.count("perforation -> embedment") >= 2  # listed per scene and summarised
+    assert f"{comparison.changed.size} with another outcome" in out
+    assert "perforation -> embedment" in out  # in ranges: tests/test_compare.py
 
 
 def test_plot_and_show_from_an_archive(tmp_path, capsys):

@@ -28,7 +28,7 @@ LAYERS = {
         "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
     },
     "storage": {"storage"},
-    "analysis": {"study", "calibration", "plotting", "limits", "export"},
+    "analysis": {"study", "comparison", "calibration", "plotting", "limits", "export"},
     "cli": {"cli"},
 }  # fmt: skip
 ORDER = list(LAYERS)

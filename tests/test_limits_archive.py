@@ -447,6 +447,7 @@ def test_bad_show_and_compare_use_is_one_line(tmp_path, plugging, by_obliquity):
         (["compare", str(path), "plugging", "nope"], ("no run 'nope'", "limits/plugging", "w/v")),
         (["compare", str(path), "plugging", "critical"], ("along the same axis",)),
         (["compare", str(path), "plugging", "plugging", "--png", png], ("--png draws runs",)),
+        (["compare", str(path), "plugging", "plugging", "--summary"], ("--summary counts",)),
     ]:
         code, out, err = run_cli(argv)
         assert_one_line(code, err, *words)
@@ -458,7 +459,7 @@ def test_compare_json_of_two_runs_is_their_summary(tmp_path):
     study = pi.Study.grid("w", [PLATE], [0, 45], np.array([300.0, 900.0]),
                           [pi.Variant("v"), pi.Variant("intact", failure="intact")])  # fmt: skip
     results = study.run(archive=path)
-    code, out, err = run_cli(["compare", str(path), "v", "intact", "--json"])
+    code, out, err = run_cli(["compare", str(path), "v", "intact", "--json", "--summary"])
     assert code == 0, err
     expected = {"a": "w/v", "b": "w/intact", **results.compare("v", "intact").summary()}
-    assert json.loads(out) == expected and expected["outcome_changes"] > 0
+    assert json.loads(out) == expected and expected["changed_scenes"] > 0

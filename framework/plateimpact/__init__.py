@@ -81,7 +81,7 @@ _EXPORTS: dict[str, str] = {
     # analysis
     "Study": "study",
     "StudyResults": "study",
-    "Comparison": "study",
+    "Comparison": "comparison",
     "Calibration": "calibration",
     "CalibrationReport": "calibration",
     "DriFit": "calibration",
@@ -147,6 +147,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         fit_dri,
         newton_fit,
     )
+    from .comparison import Comparison
     from .dense import DenseOutput, PolynomialDenseOutput, hermite
     from .discovery import BrokenPackage
     from .dynamics import Dynamics
@@ -203,7 +204,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file
     from .storage.shots import Shots, synthetic_shots
-    from .study import Comparison, Study, StudyResults
+    from .study import Study, StudyResults
     from .variant import Variant
 
     __version__: str

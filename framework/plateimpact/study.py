@@ -15,10 +15,11 @@ import numpy as np
 from . import presets
 from .batch import SceneBatch
 from .bodies import Plate, Sphere
+from .comparison.ranges import Comparison
 from .errors import ArchiveWaitWarning, ParameterError, UnknownNameError
 from .progress import progress_bar
 from .registry import PluginRegistry
-from .results import BatchResult, Outcome
+from .results import BatchResult
 from .scene import Scene
 from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
 from .storage.archive import Archive
@@ -281,46 +282,6 @@ class Study:
         return StudyResults(self, runs)
 
 
-@attrs.frozen(eq=False)
-class Comparison:
-    """Run B against run A on the same scenes: outcome changes and exit differences.
-
-    ``exit_speed_change`` [m/s] and ``exit_obliquity_change`` [rad] are B − A, NaN where
-    either run ends in embedment (no exit) for the obliquity.
-    """
-
-    run_a: str
-    run_b: str
-    outcome_a: np.ndarray
-    outcome_b: np.ndarray
-    exit_speed_change: np.ndarray
-    exit_obliquity_change: np.ndarray
-
-    @property
-    def changed(self) -> np.ndarray:
-        """Indices of the scenes whose outcome differs."""
-        return np.flatnonzero(self.outcome_a != self.outcome_b)
-
-    def summary(self) -> dict[str, object]:
-        """Counts of each outcome transition and the largest exit differences (user units)."""
-        transitions: dict[str, int] = {}
-        for i in self.changed:
-            key = f"{Outcome(self.outcome_a[i]).label} -> {Outcome(self.outcome_b[i]).label}"
-            transitions[key] = transitions.get(key, 0) + 1
-        both = np.isfinite(self.exit_obliquity_change)
-        return {
-            "scenes": int(self.outcome_a.size),
-            "outcome_changes": int(self.changed.size),
-            "transitions": transitions,
-            "max_abs_exit_speed_change_m_s": float(
-                np.max(np.abs(self.exit_speed_change), initial=0.0)
-            ),
-            "max_abs_exit_obliquity_change_deg": float(
-                np.degrees(np.max(np.abs(self.exit_obliquity_change[both]), initial=0.0))
-            ),
-        }
-
-
 class StudyResults:
     """The runs of a study, by name: each a :class:`BatchResult` over the study's scenes."""
 
@@ -356,14 +317,7 @@ class StudyResults:
             raise UnknownNameError(f"no run {name!r}; choose from: {choices}") from None
 
     def compare(self, run_a: str, run_b: str) -> Comparison:
-        """Per scene: outcome A and B, Δ exit speed and Δ exit obliquity (B − A)."""
-        a, b = self[run_a], self[run_b]
-        flying = (a.outcome != Outcome.EMBEDMENT) & (b.outcome != Outcome.EMBEDMENT)
-        return Comparison(
-            run_a,
-            run_b,
-            a.outcome.copy(),
-            b.outcome.copy(),
-            b.exit_speed - a.exit_speed,
-            np.where(flying, b.exit_obliquity - a.exit_obliquity, np.nan),
-        )
+        """Run B against run A: per scene Δ exit speed and obliquity (B − A), and the
+        outcome changes in ranges along each plate's rows (:mod:`plateimpact.comparison`)."""
+        study = self.study
+        return Comparison(run_a, run_b, self[run_a], self[run_b], study.scenes, study.plate_labels)

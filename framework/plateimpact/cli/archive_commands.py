@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from importlib.metadata import EntryPoint
 from pathlib import Path
@@ -19,11 +18,12 @@ from ..discovery import (
     installed_entry_points,
 )
 from ..errors import PluginError
-from ..results import BatchResult, Outcome
+from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
 from .common import UsageError, check_directory
+from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
 
 
@@ -53,18 +53,28 @@ def add_parsers(sub: Any) -> None:
 
     p = sub.add_parser(
         "compare",
-        help="compare two runs of an archive scene by scene, or two stored limits boundary "
-        "by boundary",
+        help="compare two runs of an archive (outcome changes in ranges of impact speed), "
+        "or two stored limits boundary by boundary",
     )
     p.add_argument("archive", help="HDF5 archive")
     p.add_argument("run_a", help="run name (STUDY/RUN, or RUN when unique), or stored limits")
     p.add_argument("run_b", help="run name (STUDY/RUN, or RUN when unique), or stored limits")
-    p.add_argument("--png", metavar="FILE", help="overlay plot of the two runs")
+    p.add_argument(
+        "--png",
+        metavar="FILE",
+        help="runs: their exit speeds and obliquities overlaid, outcome changes shaded",
+    )
+    p.add_argument(
+        "--summary",
+        action="store_true",
+        help="runs: counts only (scenes, outcome changes by pair, largest exit differences)",
+    )
     p.add_argument(
         "--json",
         action="store_true",
-        help="print one JSON object: the runs' summary, or how each boundary of two stored "
-        "limits moved (A, B: limits/NAME or NAME, as show lists them)",
+        help="print one JSON object: the runs' outcome ranges (with --summary: their "
+        "counts), or how each boundary of two stored limits moved (A, B: limits/NAME or "
+        "NAME, as show lists them)",
     )
     p.set_defaults(command_function=compare_command)
 
@@ -199,31 +209,21 @@ def compare_command(args: argparse.Namespace) -> None:
             "limits with limits"
         )
     if kind_a == "limits":
-        if args.png:
-            raise UsageError("--png draws runs; stored limits are compared as text or --json")
+        if args.png or args.summary:
+            what = "--png draws runs" if args.png else "--summary counts the outcomes of runs"
+            raise UsageError(f"{what}; stored limits are compared as text or --json")
         compare_stored(archive, args.run_a, args.run_b, args.json)
         return
     results = _study_results(archive, [args.run_a, args.run_b])
-    name_a, name_b = archive.resolve(args.run_a), archive.resolve(args.run_b)
-    comparison = results.compare(name_a, name_b)
-    if args.json:
-        print(json.dumps({"a": name_a, "b": name_b, **comparison.summary()}, indent=2))
-    else:
-        study = results.study
-        scenes = study.scenes
-        print(f"{name_b} against {name_a}: {len(results[name_a])} scenes")
-        for i in comparison.changed:
-            print(
-                f"  {study.plate_labels[i]:>14} {np.degrees(scenes.impact_obliquity[i]):5.1f} "
-                f"deg {scenes.impact_speed[i]:7.1f} m/s: "
-                f"{Outcome(comparison.outcome_a[i]).label} -> "
-                f"{Outcome(comparison.outcome_b[i]).label}"
-            )
-        print(json.dumps(comparison.summary(), indent=2))
+    comparison = results.compare(archive.resolve(args.run_a), archive.resolve(args.run_b))
+    print_comparison(comparison, as_json=args.json, summary=args.summary)
     if args.png:
         from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..comparison.figure import plot_comparison  # noqa: PLC0415
 
-        plotting.save(plotting.plot_study(results), args.png, "--png")
+        plotting.save(plot_comparison(comparison), args.png, "--png")
+        if not args.json:
+            print(f"figure: {args.png}")
 
 
 def plot_command(args: argparse.Namespace) -> None:
