@@ -1,7 +1,8 @@
-"""Every figure family of the report in one archive, with one PNG per family, and the
+"""Every figure family of the report in one archive, with one figure per family, and the
 outcome maps and limit curves of the five plates.
 
-python studies/reproduce.py [--out DIR]      (what `plateimpact reproduce` runs)
+python studies/reproduce.py [--out DIR] [--dpi DPI] [--format png|svg|pdf]
+(what `plateimpact reproduce` runs)
 """
 
 from __future__ import annotations
@@ -49,11 +50,11 @@ MAP_OBLIQUITIES = np.radians(np.arange(0.0, 85.0, 2.0))
 
 
 def outcome_maps(
-    out: Path, archive: Path, resume: bool = False
+    out: Path, archive: Path, resume: bool = False, dpi: float = plotting.DPI, suffix: str = "png"
 ) -> tuple[list[limits.OutcomeMap], list[Path]]:
     """The outcome maps of the five plates (default sphere, plugging, dopri5), stored in
     ``archive`` as ``limits/map_PLATE`` (with ``resume``, read back if there), and drawn:
-    ``outcome_maps.png`` and ``limit_curves.png``."""
+    ``outcome_maps.<suffix>`` and ``limit_curves.<suffix>``."""
     from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     names = [f"map_{plate.replace('/', '_')}" for plate in presets.PLATES]
@@ -70,24 +71,30 @@ def outcome_maps(
             if name not in stored:  # a resumed archive keeps the maps it has
                 limits.archive_limits(archive, name, drawn)
     maps = list(zip(presets.PLATES, found, strict=True))
-    paths = [out / "outcome_maps.png", out / "limit_curves.png"]
-    plotting.save(plot_outcome_map(maps), str(paths[0]))
-    plotting.save(plot_limit_curves(maps), str(paths[1]))
+    paths = [out / f"outcome_maps.{suffix}", out / f"limit_curves.{suffix}"]
+    plotting.save(plot_outcome_map(maps), str(paths[0]), dpi=dpi)
+    plotting.save(plot_limit_curves(maps), str(paths[1]), dpi=dpi)
     return found, paths
 
 
 def reproduce(
-    out: Path, progress: bool | None = None, resume: bool = False
+    out: Path,
+    progress: bool | None = None,
+    resume: bool = False,
+    dpi: float = plotting.DPI,
+    suffix: str = "png",
 ) -> tuple[Path, list[Path]]:
-    """Run every family into ``out/report.h5`` and draw its PNGs. An existing archive is
-    appended to (its earlier runs kept; the new ones get a ``.2``, ``.3`` suffix), or with
-    ``resume`` its finished runs are read back and only the missing ones run."""
+    """Run every family into ``out/report.h5`` and draw its figures (``suffix``: png, svg
+    or pdf; ``dpi`` [dots per inch] for PNG). An existing archive is appended to (its
+    earlier runs kept; the new ones get a ``.2``, ``.3`` suffix), or with ``resume`` its
+    finished runs are read back and only the missing ones run."""
     out.mkdir(parents=True, exist_ok=True)
     archive = out / ARCHIVE_NAME
-    figures = [run_and_plot(f.study(), out, archive, progress, resume=resume) for f in FAMILIES]
+    drawing = {"resume": resume, "dpi": dpi, "suffix": suffix}
+    figures = [run_and_plot(f.study(), out, archive, progress, **drawing) for f in FAMILIES]
     craters = fig35_37_craters_60deg.study()
-    figures.append(run_and_plot(craters, out, archive, progress, craters=True, resume=resume))
-    figures += outcome_maps(out, archive, resume)[1]
+    figures.append(run_and_plot(craters, out, archive, progress, craters=True, **drawing))
+    figures += outcome_maps(out, archive, **drawing)[1]
     return archive, figures
 
 
@@ -95,9 +102,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="report", help="output directory (created)")
     parser.add_argument("--resume", action="store_true", help="run only the missing runs")
+    parser.add_argument("--dpi", type=float, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     start = time.perf_counter()
-    archive, figures = reproduce(Path(args.out), resume=args.resume)
+    archive, figures = reproduce(
+        Path(args.out), resume=args.resume, dpi=args.dpi, suffix=args.format
+    )
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")

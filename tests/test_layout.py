@@ -28,7 +28,7 @@ LAYERS = {
         "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
     },
     "storage": {"storage"},
-    "analysis": {"study", "calibration", "plotting", "limits"},
+    "analysis": {"study", "calibration", "plotting", "path_figures", "limits"},
     "cli": {"cli"},
 }  # fmt: skip
 ORDER = list(LAYERS)

@@ -21,8 +21,9 @@ from ..discovery import (
 from ..errors import PluginError
 from ..results import BatchResult, Outcome
 from ..storage.archive import Archive
+from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE
 from ..study import Study, StudyResults
-from .common import UsageError, check_directory
+from .common import UsageError, check_directory, dots_per_inch
 from .stored_limits import compare_stored, kinds, show_stored
 
 
@@ -34,6 +35,13 @@ def add_parsers(sub: Any) -> None:
         action="store_true",
         help="keep the runs already in DIR/report.h5 and run only the missing ones "
         "(default: add every run again, as NAME.2, ...)",
+    )
+    _add_dpi(p)
+    p.add_argument(
+        "--format",
+        choices=("png", "svg", "pdf"),
+        default="png",
+        help="the figures' format (default: png; svg and pdf are vector, for print)",
     )
     p.set_defaults(command_function=reproduce_command)
 
@@ -65,7 +73,13 @@ def add_parsers(sub: Any) -> None:
     )
     p.add_argument("archive", help="HDF5 archive")
     p.add_argument("--run", required=True, action="append", help="run name (repeat to overlay)")
-    p.add_argument("--out", required=True, metavar="FILE.png", help="where to draw")
+    p.add_argument(
+        "--out",
+        required=True,
+        metavar="FILE",
+        help="where to draw; the format from the extension (.png, .svg, .pdf, ...)",
+    )
+    _add_dpi(p)
     p.add_argument(
         "--kind",
         choices=("exit", "trajectory", "crater"),
@@ -82,6 +96,16 @@ def add_parsers(sub: Any) -> None:
         "default: six spread over the range)",
     )
     p.set_defaults(command_function=plot_command)
+
+
+def _add_dpi(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--dpi",
+        type=dots_per_inch,
+        default=FIGURE_DPI,
+        help=f"resolution of raster figures, {FIGURE_DPI_RANGE[0]:g}-{FIGURE_DPI_RANGE[1]:g} "
+        f"dots per inch (default: {FIGURE_DPI:g}; study figures are 7.2 in wide)",
+    )
 
 
 #: The entry-point group of runnable study collections; ``reproduce`` runs ``report``.
@@ -122,7 +146,7 @@ def reproduce_command(args: argparse.Namespace) -> None:
         raise UsageError(f"--out: {args.out!r} exists and is not a directory")
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
-    archive, figures = reproduce(out, resume=args.resume)
+    archive, figures = reproduce(out, resume=args.resume, dpi=args.dpi, suffix=args.format)
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")
@@ -208,6 +232,7 @@ def compare_command(args: argparse.Namespace) -> None:
 
 def plot_command(args: argparse.Namespace) -> None:
     from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..path_figures import plot_study_paths  # noqa: PLC0415
 
     check_directory(args.out, "--out", "figure")
     for speed in args.speed or ():
@@ -218,8 +243,8 @@ def plot_command(args: argparse.Namespace) -> None:
         figure = plotting.plot_study(results)
     else:
         try:
-            figure = plotting.plot_study_paths(results, kind=args.kind, speeds=args.speed)
+            figure = plot_study_paths(results, kind=args.kind, speeds=args.speed)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
-    plotting.save(figure, args.out, "--out")
+    plotting.save(figure, args.out, "--out", dpi=args.dpi)
     print(f"figure: {args.out}")
