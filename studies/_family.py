@@ -7,6 +7,7 @@ from pathlib import Path
 
 import plateimpact as pi
 from plateimpact import path_figures, plotting
+from plateimpact.cli.common import dots_per_inch
 
 #: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]
@@ -39,7 +40,7 @@ def run_and_plot(
 def main(study: pi.Study, craters: bool = False) -> None:
     parser = argparse.ArgumentParser(description=study.description)
     parser.add_argument("--out", default=".", help="directory for the archive and the figure")
-    parser.add_argument("--dpi", type=float, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
     parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     out = Path(args.out)

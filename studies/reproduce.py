@@ -15,6 +15,7 @@ import numpy as np
 
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
+from plateimpact.cli.common import dots_per_inch
 
 try:
     from . import (
@@ -102,7 +103,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="report", help="output directory (created)")
     parser.add_argument("--resume", action="store_true", help="run only the missing runs")
-    parser.add_argument("--dpi", type=float, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
     parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     start = time.perf_counter()
