@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 import plateimpact as pi
-from plateimpact import plotting
+from plateimpact import path_figures, plotting
+from plateimpact.cli.common import dots_per_inch
 
 #: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]
@@ -26,28 +27,34 @@ def run_and_plot(
     resume: bool = False,
     overwrite: bool = False,
     tag: str | None = None,
+    dpi: float = plotting.DPI,
+    suffix: str = "png",
 ) -> Path:
     """Run ``study`` (appending its runs to ``archive``; with ``resume``, only those not
     there yet; with ``overwrite`` replacing them; with ``tag``, as ``VARIANT@TAG``) and
-    draw ``out/<study>.png``: exit curves, or with ``craters`` the crater sections (the
-    runs then keep paths and craters)."""
+    draw ``out/<study>.<suffix>`` (at ``dpi`` [dots per inch] if a raster): exit
+    curves, or with ``craters`` the crater sections (the runs then keep paths and
+    craters)."""
     results = study.run(
         archive=archive, progress=progress, craters=craters, resume=resume,
         overwrite=overwrite, run_names=tagged(study, tag),
     )  # fmt: skip
     if craters:
-        figure = plotting.plot_study_paths(results, kind="crater")
+        figure = path_figures.plot_study_paths(results, kind="crater")
     else:
         figure = plotting.plot_study(results)
-    path = out / f"{study.name}.png"
-    plotting.save(figure, str(path))
+    path = out / f"{study.name}.{suffix}"
+    plotting.save(figure, str(path), dpi=dpi)
     return path
 
 
 def main(study: pi.Study, craters: bool = False) -> None:
     parser = argparse.ArgumentParser(description=study.description)
-    parser.add_argument("--out", default=".", help="directory for the archive and the PNG")
+    parser.add_argument("--out", default=".", help="directory for the archive and the figure")
+    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     out = Path(args.out)
-    png = run_and_plot(study, out, out / f"{study.name}.h5", craters=craters)
-    print(f"archive: {out / f'{study.name}.h5'}\nfigure:  {png}")
+    drawn = run_and_plot(study, out, out / f"{study.name}.h5", craters=craters,
+                         dpi=args.dpi, suffix=args.format)  # fmt: skip
+    print(f"archive: {out / f'{study.name}.h5'}\nfigure:  {drawn}")

@@ -1,7 +1,8 @@
-"""Every figure family of the report in one archive, with one PNG per family, and the
+"""Every figure family of the report in one archive, with one figure per family, and the
 outcome maps and limit curves of the five plates.
 
-python studies/reproduce.py [--out DIR]      (what `plateimpact reproduce` runs)
+python studies/reproduce.py [--out DIR] [--dpi DPI] [--format png|svg|pdf]
+(what `plateimpact reproduce` runs)
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
+from plateimpact.cli.common import dots_per_inch
 
 try:
     from . import (
@@ -49,16 +51,22 @@ MAP_OBLIQUITIES = np.radians(np.arange(0.0, 85.0, 2.0))
 
 
 def outcome_maps(
-    out: Path, archive: Path, resume: bool = False, overwrite: bool = False, tag: str | None = None
+    out: Path,
+    archive: Path,
+    resume: bool = False,
+    overwrite: bool = False,
+    tag: str | None = None,
+    dpi: float = plotting.DPI,
+    suffix: str = "png",
 ) -> tuple[list[limits.OutcomeMap], list[Path]]:
     """The outcome maps of the five plates (default sphere, plugging, dopri5), stored in
     ``archive`` as ``limits/map_PLATE`` (or ``map_PLATE@TAG``; with ``resume``, read back
-    if there; with ``overwrite``, replaced), and drawn: ``outcome_maps.png`` and
-    ``limit_curves.png``."""
+    if there; with ``overwrite``, replaced), and drawn: ``outcome_maps.<suffix>`` and
+    ``limit_curves.<suffix>`` (at ``dpi`` [dots per inch] if a raster)."""
     from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
-    suffix = "" if tag is None else f"@{tag}"
-    names = [f"map_{plate.replace('/', '_')}{suffix}" for plate in presets.PLATES]
+    marker = "" if tag is None else f"@{tag}"
+    names = [f"map_{plate.replace('/', '_')}{marker}" for plate in presets.PLATES]
     stored = set(limits.stored_limits(archive)) if resume and archive.exists() else set()
     kept = [limits.read_limits(archive, name) for name in names if name in stored]
     found = [m for m in kept if isinstance(m, limits.OutcomeMap)]
@@ -72,9 +80,9 @@ def outcome_maps(
             if name not in stored:  # a resumed archive keeps the maps it has
                 limits.archive_limits(archive, name, drawn, overwrite=overwrite)
     maps = list(zip(presets.PLATES, found, strict=True))
-    paths = [out / "outcome_maps.png", out / "limit_curves.png"]
-    plotting.save(plot_outcome_map(maps), str(paths[0]))
-    plotting.save(plot_limit_curves(maps), str(paths[1]))
+    paths = [out / f"outcome_maps.{suffix}", out / f"limit_curves.{suffix}"]
+    plotting.save(plot_outcome_map(maps), str(paths[0]), dpi=dpi)
+    plotting.save(plot_limit_curves(maps), str(paths[1]), dpi=dpi)
     return found, paths
 
 
@@ -84,11 +92,14 @@ def reproduce(
     resume: bool = False,
     overwrite: bool = False,
     tag: str | None = None,
+    dpi: float = plotting.DPI,
+    suffix: str = "png",
 ) -> tuple[Path, list[Path]]:
-    """Run every family into ``out/report.h5`` and draw its PNGs. Runs already in the
-    archive are refused before anything runs, unless ``resume`` (read them back, run
-    only the missing ones), ``overwrite`` (replace them) or ``tag`` (store the new runs
-    as ``VARIANT@TAG``, the maps as ``map_PLATE@TAG``)."""
+    """Run every family into ``out/report.h5`` and draw its figures (``suffix``: png, svg
+    or pdf; ``dpi`` [dots per inch] for PNG). Runs already in the archive are refused
+    before anything runs, unless ``resume`` (read them back, run only the missing ones),
+    ``overwrite`` (replace them) or ``tag`` (store the new runs as ``VARIANT@TAG``, the
+    maps as ``map_PLATE@TAG``)."""
     out.mkdir(parents=True, exist_ok=True)
     archive = out / ARCHIVE_NAME
     studies = [f.study() for f in FAMILIES]
@@ -96,12 +107,11 @@ def reproduce(
     for study in [*studies, craters]:  # a run that is there is refused before any runs
         names = tagged(study, tag)
         study.check_archive(archive, resume=resume, overwrite=overwrite, run_names=names)
-    figures = [
-        run_and_plot(s, out, archive, progress, resume=resume, overwrite=overwrite, tag=tag)
-        for s in studies
-    ]
-    figures.append(run_and_plot(craters, out, archive, progress, True, resume, overwrite, tag))
-    figures += outcome_maps(out, archive, resume, overwrite, tag)[1]
+    rerun = {"resume": resume, "overwrite": overwrite, "tag": tag}
+    drawing = {"dpi": dpi, "suffix": suffix}
+    figures = [run_and_plot(s, out, archive, progress, **rerun, **drawing) for s in studies]
+    figures.append(run_and_plot(craters, out, archive, progress, craters=True, **rerun, **drawing))
+    figures += outcome_maps(out, archive, **rerun, **drawing)[1]
     return archive, figures
 
 
@@ -112,9 +122,13 @@ def main() -> None:
     rerun.add_argument("--resume", action="store_true", help="run only the missing runs")
     rerun.add_argument("--overwrite", action="store_true", help="replace the runs there")
     rerun.add_argument("--as", dest="tag", metavar="TAG", help="store new runs as VARIANT@TAG")
+    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     start = time.perf_counter()
-    archive, figures = reproduce(Path(args.out), None, args.resume, args.overwrite, args.tag)
+    archive, figures = reproduce(
+        Path(args.out), None, args.resume, args.overwrite, args.tag, args.dpi, args.format
+    )
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")

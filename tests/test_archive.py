@@ -381,7 +381,13 @@ def test_reproduce_writes_one_archive_and_a_figure_per_family(tmp_path, capsys):
     pngs = sorted(out.glob("*.png"))
     assert len(pngs) == 8 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
     assert str(out / "report.h5") in capsys.readouterr().out
-    assert cli(["reproduce", "--out", str(out), "--resume"]) == 0  # everything is there
+    for family in ("6061-T6_9.53mm", "SAE1010_1.47mm"):  # a journal page, 7.2 in at 150 dpi
+        assert (out / f"{family}.png").read_bytes()[16:20] == (1080).to_bytes(4, "big")
+    # Everything is there: the figures again, as PDF.
+    assert cli(["reproduce", "--out", str(out), "--resume", "--format", "pdf"]) == 0
+    pdfs = sorted(out.glob("*.pdf"))
+    assert [p.stem for p in pdfs] == [p.stem for p in pngs]
+    assert all(p.read_bytes()[:5] == b"%PDF-" for p in pdfs)
     assert len(pi.Archive(out / "report.h5").runs()) == 8
     assert stored_limits(out / "report.h5") == maps  # read back, not stored twice
     assert cli(["reproduce", "--out", str(tmp_path / "missing" / "report")]) == 2

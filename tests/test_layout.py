@@ -28,7 +28,9 @@ LAYERS = {
         "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
     },
     "storage": {"storage"},
-    "analysis": {"study", "comparison", "calibration", "plotting", "limits", "export"},
+    "analysis": {
+        "study", "comparison", "calibration", "plotting", "path_figures", "limits", "export",
+    },
     "cli": {"cli"},
 }  # fmt: skip
 ORDER = list(LAYERS)

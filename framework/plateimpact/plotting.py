@@ -1,7 +1,8 @@
 """Figures in the layout of the report: outcome curves against impact speed, craters.
 
-matplotlib is imported here only, so the rest of plateimpact does not need a display
-or pay the import time. Figures are made as :class:`matplotlib.figure.Figure` objects,
+matplotlib is imported here (and in path_figures and limits.figures, which draw with
+these pieces) only, so the rest of plateimpact does not need a display or pay the
+import time. Figures are made as :class:`matplotlib.figure.Figure` objects,
 not through pyplot: nothing here touches the user's backend or pyplot's state, so the
 functions work the same in a script, a notebook and an interactive session. Functions
 draw on axes you pass and return them; :func:`figure` gives a figure and its axes.
@@ -9,26 +10,27 @@ draw on axes you pass and return them; :func:`figure` gives a figure and its axe
 
 from __future__ import annotations
 
+import math
 import os
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
+from .limits.regimes import REGIMES, Regime, regime_codes
 from .results import BatchResult, CraterSection, Outcome, Trajectory
-from .storage.output import write_output
+from .storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, write_output
 
 if TYPE_CHECKING:
     from .calibration import DriFit
     from .storage.shots import Shots
     from .study import StudyResults
-
-#: Resolution of saved figures [dots per inch].
-DPI = 120
 
 
 def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
@@ -37,52 +39,229 @@ def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
     return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
-OUTCOME_SHADES = {
-    Outcome.RICOCHET: "#dbe9f6",
-    Outcome.EMBEDMENT: "#f3e3c3",
-    Outcome.PERFORATION: "#dcefd8",
+#: Resolution of saved raster figures by default, and the range accepted [dots per inch].
+DPI, DPI_RANGE = FIGURE_DPI, FIGURE_DPI_RANGE
+#: Journal widths [in]: one column, two columns (the page).
+COLUMN_WIDTH, PAGE_WIDTH = 3.5, 7.2
+#: Font sizes [pt] of figures drawn at journal width: labels and titles, ticks and keys.
+FONT, SMALL = 7.0, 6.0
+#: The most columns of panels a study figure has; more obliquities make more rows.
+MAX_COLUMNS = 4
+
+#: One colour per regime, shared by the family figures' outcome strips and the outcome
+#: maps (limits.figures); the thin-plate band (ricochet after failure) stands out.
+REGIME_COLOURS = {
+    REGIMES[0]: "#4c72b0",  # ricochet
+    REGIMES[1]: "#a05fc0",  # ricochet after failure
+    REGIMES[2]: "#dd8452",  # embedment
+    REGIMES[3]: "#e6c85a",  # embedment after failure
+    REGIMES[4]: "#55a868",  # perforation
 }
+#: Line colours and styles of a study's runs, in order (black and dashed read in print).
+RUN_STYLES: list[dict[str, Any]] = [
+    {"color": "k", "ls": "-"},
+    {"color": "C3", "ls": "--"},
+    {"color": "C0", "ls": ":"},
+    {"color": "C2", "ls": "-."},
+    {"color": "C4", "ls": (0, (5, 1))},
+]
 
 
-def shade_outcomes(ax: Axes, speeds: np.ndarray, outcome: np.ndarray) -> None:
-    """Shade the impact-speed ranges [m/s] of each outcome, split half-way between grid points."""
-    edges = np.concatenate([[speeds[0]], 0.5 * (speeds[1:] + speeds[:-1]), [speeds[-1]]])
-    start = 0
-    for i in range(1, len(speeds) + 1):
-        if i == len(speeds) or outcome[i] != outcome[start]:
-            code = Outcome(int(outcome[start]))
-            ax.axvspan(edges[start], edges[i], color=OUTCOME_SHADES[code], lw=0, zorder=0)
-            start = i
+def regime_colour(regime: Regime) -> str:
+    return REGIME_COLOURS.get(regime, "#999999")
+
+
+def regime_key(regimes: Sequence[Regime] | set[Regime]) -> list[Patch]:
+    """Legend handles: one coloured patch per regime present, in the order of REGIMES."""
+    return [Patch(color=regime_colour(r), label=r.label) for r in REGIMES if r in regimes]
+
+
+def _stretches(codes: np.ndarray) -> list[slice]:
+    """The runs of equal consecutive values of ``codes``, as slices."""
+    cuts = np.concatenate([[0], np.flatnonzero(np.diff(codes)) + 1, [codes.size]])
+    return [slice(int(a), int(b)) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
 
 
 def plot_exit_curves(
-    axes: Sequence[Axes],
+    axes: Sequence[Axes | None],
     speeds: np.ndarray,
     result: BatchResult,
     *,
     label: str | None = None,
-    shade: bool = True,
     **style: Any,
-) -> Sequence[Axes]:
-    """Exit speed and exit obliquity against impact speed (the report's Figures 11–44).
+) -> Sequence[Axes | None]:
+    """Exit speed [m/s] and exit obliquity [deg] against impact speed [m/s] (the
+    report's Figures 11-44) on (speed axes, obliquity axes); either may be None.
 
-    ``axes`` are (speed axes, obliquity axes); ``speeds`` the impact speeds [m/s] of the
-    scenes of ``result``, in order. Embedments have exit speed 0; their obliquity is the
-    direction at rest.
+    ``speeds`` are the impact speeds of the scenes of ``result``, in increasing order.
+    Each stretch of scenes with one regime is its own line, so no line joins two outcomes
+    (nor a ricochet off an intact plate to one off a failed plate); a stretch of one scene
+    is a dot. Embedded spheres have no exit and are not drawn: :func:`plot_outcome_strip`
+    shows where they are.
     """
     speed_ax, obliquity_ax = axes
-    if shade:
-        for ax in axes:
-            shade_outcomes(ax, speeds, result.outcome)
-    speed_ax.plot(speeds, result.exit_speed, label=label, **style)
-    obliquity_ax.plot(speeds, np.degrees(result.exit_obliquity), label=label, **style)
-    speed_ax.set_ylabel("exit speed [m/s]")
-    obliquity_ax.set_ylabel("exit obliquity [deg]")
-    obliquity_ax.set_ylim(0, 185)
-    for ax in axes:
-        ax.set_xlabel("impact speed [m/s]")
-        ax.set_xlim(speeds[0], speeds[-1])
+    codes = regime_codes(result)
+    for part in _stretches(codes):
+        if Regime.of_code(codes[part.start]).outcome is Outcome.EMBEDMENT:
+            continue
+        marker = "." if part.stop - part.start == 1 else ""
+        for ax, value in (
+            (speed_ax, result.exit_speed),
+            (obliquity_ax, np.degrees(result.exit_obliquity)),
+        ):
+            if ax is not None:
+                ax.plot(speeds[part], value[part], marker=marker, ms=2, label=label, **style)
+        label = "_nolegend_"  # one legend entry per run
     return axes
+
+
+def plot_outcome_strip(
+    ax: Axes, speeds: np.ndarray, results: Sequence[tuple[str, BatchResult]]
+) -> set[Regime]:
+    """One bar per run (first on top), coloured by regime along the impact speeds [m/s]
+    (ranges split half-way between grid points); returns the regimes drawn. A range of
+    one scene stays visible: each bar is edged in its own colour."""
+    edges = np.concatenate([[speeds[0]], 0.5 * (speeds[1:] + speeds[:-1]), [speeds[-1]]])
+    drawn = set()
+    for row, (_, result) in enumerate(results):
+        codes = regime_codes(result)
+        for part in _stretches(codes):
+            regime = Regime.of_code(codes[part.start])
+            drawn.add(regime)
+            start, end = edges[part.start], edges[part.stop]
+            colour = regime_colour(regime)
+            ax.broken_barh([(start, end - start)], (row - 0.4, 0.8), facecolors=colour,
+                           edgecolors=colour, linewidth=0.6)  # fmt: skip
+    ax.set_ylim(len(results) - 0.5, -0.5)
+    ax.set_yticks(range(len(results)), [name for name, _ in results])
+    ax.tick_params(axis="y", length=0)
+    return drawn
+
+
+def _along_the_normal(parts: Sequence[BatchResult]) -> list[float] | None:
+    """The exit obliquities [deg] of these scenes when all are 0 or 180 (normal
+    incidence: the sphere leaves along the normal; none if every sphere embedded), else
+    None."""
+    exits = np.concatenate(
+        [np.degrees(p.exit_obliquity[p.outcome != Outcome.EMBEDMENT]) for p in parts]
+    )
+    trivial = np.isclose(exits, 0.0, atol=1e-6) | np.isclose(exits, 180.0, atol=1e-6)
+    return sorted({float(round(v)) for v in exits}) if trivial.all() else None
+
+
+def _grid_shape(count: int) -> tuple[int, int]:
+    """(rows, columns) of ``count`` panels: at most MAX_COLUMNS columns, rows as even as
+    they can be."""
+    rows = math.ceil(count / MAX_COLUMNS)
+    return rows, math.ceil(count / rows)
+
+
+def study_panels(results: StudyResults) -> list[tuple[str, float, np.ndarray]]:
+    """(plate label, obliquity [deg], scene indices sorted by impact speed) per panel."""
+    study = results.study
+    labels = np.array(study.plate_labels)
+    obliquity = np.round(np.degrees(study.scenes.impact_obliquity), 6)
+    panels = []
+    for label in dict.fromkeys(study.plate_labels):
+        for ob in sorted(set(obliquity[labels == label])):
+            index = np.flatnonzero((labels == label) & (obliquity == ob))
+            panels.append((label, ob, index[np.argsort(study.scenes.impact_speed[index])]))
+    return panels
+
+
+def short_run_name(run: str, study: str) -> str:
+    """A run's name without its study's prefix (the study is in the title)."""
+    return run.removeprefix(f"{study}/")
+
+
+def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> Figure:
+    """Exit speed and exit obliquity against impact speed for every plate × obliquity of a
+    study (the report's Figures 11-44; the comparison layout of Figures 30-31 when there
+    are several runs), drawn at journal width: 7.2 in, 3.5 in for one panel.
+
+    One panel per (plate, obliquity), at most four to a row: exit speed over exit
+    obliquity over an outcome strip, one bar per run coloured by regime; the key below.
+    Runs are black solid, red dashed, blue dotted, ... Curves break where the regime
+    changes; embedments appear in the strips only. At normal incidence, where every exit
+    obliquity is 0° (or 180°), the obliquity frame says so instead of a flat line.
+    """
+    study = results.study
+    runs = list(runs or results.runs)
+    panels = study_panels(results)
+    nrows, ncols = _grid_shape(len(panels))
+    curve, strip = 1.1, 0.08 + 0.12 * len(runs)  # heights [in]
+    width = PAGE_WIDTH if ncols > 1 else COLUMN_WIDTH
+    height = nrows * (2 * curve + strip + 0.45) + 0.6
+    fig = Figure(figsize=(width, height), layout="constrained")
+    grid = fig.add_gridspec(3 * nrows, ncols, height_ratios=[curve, curve, strip] * nrows)
+    shared: list[Axes] = []  # the first panel's exit-speed and exit-obliquity axes
+    regimes: set[Regime] = set()
+    for n, (label, ob, index) in enumerate(panels):
+        row, column = divmod(n, ncols)
+        speed_ax = fig.add_subplot(grid[3 * row, column], sharey=shared[0] if shared else None)
+        obliquity_ax = fig.add_subplot(
+            grid[3 * row + 1, column], sharex=speed_ax, sharey=shared[1] if shared else None
+        )
+        strip_ax = fig.add_subplot(grid[3 * row + 2, column], sharex=speed_ax)
+        shared = shared or [speed_ax, obliquity_ax]
+        parts = [(short_run_name(run, study.name), results[run].take(index)) for run in runs]
+        speeds = study.scenes.impact_speed[index]
+        regimes |= _draw_panel((speed_ax, obliquity_ax, strip_ax), speeds, parts, ob == 0)
+        speed_ax.set_title(f"{label}, {ob:g}°", fontsize=FONT, pad=3)
+        if column == 0:
+            speed_ax.set_ylabel("exit speed [m/s]", fontsize=FONT)
+            obliquity_ax.set_ylabel("exit obliquity [deg]", fontsize=FONT)
+        else:
+            for ax in (speed_ax, obliquity_ax, strip_ax):
+                ax.tick_params(labelleft=False)
+        if n + ncols >= len(panels):  # no panel below
+            strip_ax.set_xlabel("impact speed [m/s]", fontsize=FONT)
+    lines = [
+        Line2D(
+            [], [], lw=1.0, label=short_run_name(run, study.name), **RUN_STYLES[k % len(RUN_STYLES)]
+        )
+        for k, run in enumerate(runs)
+    ]
+    entries = [*lines, *regime_key(regimes)]
+    fig.legend(handles=entries, loc="outside lower center", fontsize=SMALL, frameon=False,
+               ncol=len(entries) if len(entries) <= 5 else math.ceil(len(entries) / 2))  # fmt: skip
+    plates = ", ".join(dict.fromkeys(study.plate_labels))
+    title = f"{plates} (study {study.name})" + (f": {study.description}" * bool(study.description))
+    fig.suptitle(textwrap.fill(title, int(width * 16)), fontsize=FONT + 1)  # 16 chars per in
+    return fig
+
+
+def _draw_panel(
+    axes: tuple[Axes, Axes, Axes],
+    speeds: np.ndarray,
+    parts: Sequence[tuple[str, BatchResult]],
+    normal_incidence: bool,
+) -> set[Regime]:
+    """One panel of :func:`plot_study`: the runs' exit curves and outcome strip."""
+    speed_ax, obliquity_ax, strip_ax = axes
+    along = _along_the_normal([part for _, part in parts]) if normal_incidence else None
+    for k, (run, part) in enumerate(parts):
+        style = RUN_STYLES[k % len(RUN_STYLES)]
+        plot_exit_curves([speed_ax, None if along is not None else obliquity_ax], speeds,
+                         part, label=run, lw=1.0, **style)  # fmt: skip
+    if along is not None:
+        angles = " or ".join(f"{v:g}°" for v in along)
+        note = f"every exit obliquity is {angles}" if along else "no sphere leaves the plate"
+        obliquity_ax.text(0.5, 0.5, f"normal incidence:\n{note}",
+                          transform=obliquity_ax.transAxes, ha="center", va="center",
+                          fontsize=SMALL, color="0.35")  # fmt: skip
+    drawn = plot_outcome_strip(strip_ax, speeds, parts)
+    if len(parts) == 1:
+        strip_ax.set_yticks([])
+    obliquity_ax.set_ylim(-8, 188)
+    obliquity_ax.set_yticks([0, 45, 90, 135, 180])
+    if speeds[-1] > speeds[0]:  # one speed: matplotlib's own margins
+        strip_ax.set_xlim(speeds[0], speeds[-1])
+    for ax in axes:
+        ax.tick_params(labelsize=SMALL, length=2.5, width=0.6, pad=2)
+    for ax in axes[:2]:
+        ax.tick_params(labelbottom=False)
+    return drawn
 
 
 def plot_crater(
@@ -158,137 +337,18 @@ def plot_calibration(
     return ax
 
 
-def save(fig: Figure, path: str | os.PathLike[str], flag: str = "figure") -> None:
+def save(fig: Figure, path: str | os.PathLike[str], flag: str = "figure", dpi: float = DPI) -> None:
     """Save a figure, its format from the file's extension (PNG, SVG, PDF, ...), all of it
-    or nothing: written beside the target and renamed over it (storage.output)."""
+    or nothing: written beside the target and renamed over it (storage.output). ``dpi``
+    [dots per inch] sets a raster's pixels. A figure with a layout engine keeps its size
+    (a PNG is ``dpi`` × its inches); one without is cropped to what is drawn."""
+    if not DPI_RANGE[0] <= dpi <= DPI_RANGE[1]:  # also refuses NaN
+        raise ValueError(f"dpi must be from {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g}, got {dpi}")
     suffix = Path(path).suffix.lower().lstrip(".")
+    crop = None if fig.get_layout_engine() else "tight"
     write_output(
         path,
         flag,
-        lambda handle: fig.savefig(handle, format=suffix, dpi=DPI, bbox_inches="tight"),
+        lambda handle: fig.savefig(handle, format=suffix, dpi=dpi, bbox_inches=crop),
         kind="figure",
     )
-
-
-def plot_study(results: StudyResults, runs: Sequence[str] | None = None) -> Figure:
-    """Exit speed and exit obliquity against impact speed for every plate × obliquity of a
-    study: one column per (plate, obliquity), the first run solid with its outcome ranges
-    shaded, further runs dashed on top (the report's comparison layout, Figures 30–31)."""
-    study = results.study
-    runs = list(runs or results.runs)
-    labels = np.array(study.plate_labels)
-    obliquity = np.round(np.degrees(study.scenes.impact_obliquity), 6)
-    panels = [
-        (label, ob)
-        for label in dict.fromkeys(study.plate_labels)
-        for ob in sorted(set(obliquity[labels == label]))
-    ]
-    fig, axes = figure(
-        2,
-        len(panels),
-        figsize=(3.2 * len(panels), 6),
-        sharex="col",
-        squeeze=False,
-        layout="constrained",
-    )
-    for column, (label, ob) in enumerate(panels):
-        index = np.flatnonzero((labels == label) & (obliquity == ob))
-        index = index[np.argsort(study.scenes.impact_speed[index])]
-        speeds = study.scenes.impact_speed[index]
-        for k, run in enumerate(runs):
-            part = results[run].take(index)
-            style = {"color": f"C{k}", "ls": "-" if k == 0 else "--"}
-            plot_exit_curves(axes[:, column], speeds, part, label=run, shade=k == 0, **style)
-        axes[0, column].set_title(f"{label}, {ob:g}°", fontsize=9)
-        axes[0, column].set_xlabel("")
-        if column:
-            for ax in axes[:, column]:
-                ax.set_ylabel("")
-    axes[0, 0].legend(fontsize=8)
-    fig.suptitle(f"{study.name}: ricochet | embedment | perforation ranges shaded ({runs[0]})")
-    return fig
-
-
-#: What :func:`plot_study_paths` can draw from a run.
-PATH_KINDS = ("trajectory", "crater")
-
-
-def _panels(results: StudyResults) -> list[tuple[str, float, np.ndarray]]:
-    """(plate label, obliquity [deg], scene indices sorted by impact speed) per panel."""
-    study = results.study
-    labels = np.array(study.plate_labels)
-    obliquity = np.round(np.degrees(study.scenes.impact_obliquity), 6)
-    panels = []
-    for label in dict.fromkeys(study.plate_labels):
-        for ob in sorted(set(obliquity[labels == label])):
-            index = np.flatnonzero((labels == label) & (obliquity == ob))
-            panels.append((label, ob, index[np.argsort(study.scenes.impact_speed[index])]))
-    return panels
-
-
-def _pick(speeds: np.ndarray, wanted: Sequence[float] | None, count: int) -> np.ndarray:
-    """Positions in ``speeds`` (sorted) nearest each wanted speed, or ``count`` spread evenly."""
-    if wanted is None:
-        return np.unique(
-            np.linspace(0, speeds.size - 1, min(count, speeds.size)).round().astype(int)
-        )
-    return np.unique([int(np.argmin(np.abs(speeds - w))) for w in wanted])
-
-
-def plot_study_paths(
-    results: StudyResults,
-    runs: Sequence[str] | None = None,
-    *,
-    kind: str = "crater",
-    speeds: Sequence[float] | None = None,
-    count: int = 6,
-) -> Figure:
-    """Crater sections (eqs 31–39) or the centre's trajectories, one panel per plate ×
-    obliquity of a study, one line per impact speed [m/s] (``speeds``: the scenes nearest
-    these; default ``count`` spread over the range); the first run solid, others dashed.
-
-    Craters need runs made with ``craters=True``, trajectories ``record_trajectory=True``.
-    Depth is drawn downward in mm: craters from the entry point, trajectories from the
-    first-contact point, with the plate's back surface dotted.
-    """
-    if kind not in PATH_KINDS:
-        raise ValueError(f"kind must be one of {', '.join(PATH_KINDS)}, got {kind!r}")
-    study = results.study
-    runs = list(runs or results.runs)
-    for run in runs:
-        if (results[run].craters if kind == "crater" else results[run].trajectory) is None:
-            need = "craters=True" if kind == "crater" else "record_trajectory=True"
-            raise ValueError(f"run {run!r} has no {kind} data: run the study with {need}")
-    panels = _panels(results)
-    fig, axes = figure(
-        len(panels), 1, figsize=(8, 2.6 * len(panels)), squeeze=False, layout="constrained"
-    )
-    for ax, (label, ob, index) in zip(axes[:, 0], panels, strict=True):
-        chosen = index[_pick(study.scenes.impact_speed[index], speeds, count)]
-        colours = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, chosen.size))
-        thickness = study.scenes.thickness[chosen[0]] * 1e3
-        for k, run in enumerate(runs):
-            result = results[run]
-            for colour, i in zip(colours, chosen, strict=True):
-                style = {"color": colour, "ls": "-" if k == 0 else "--", "lw": 1.2}
-                name = f"{study.scenes.impact_speed[i]:g} m/s, {Outcome(result.outcome[i]).label}"
-                if kind == "crater":
-                    section = result.crater_of(i)
-                    assert section is not None  # checked above
-                    ax.plot(section.lateral * 1e3, section.depth * 1e3, label=name, **style)
-                else:
-                    path = result.trajectory_of(i)
-                    assert path is not None  # checked above
-                    centre = (path.penetration - study.scenes.radius[i]) * 1e3
-                    ax.plot(path.lateral * 1e3, centre, label=name, **style)
-        ax.axhline(0.0, color="0.3", lw=0.8)
-        ax.axhline(thickness, color="0.3", lw=0.8, ls=":")
-        ax.set_title(f"{label}, {ob:g}° ({', '.join(runs)})", fontsize=9)
-        ax.set_xlabel("along the plate [mm]")
-        ax.set_ylabel("depth [mm]" if kind == "crater" else "centre depth [mm]")
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.invert_yaxis()
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    what = "crater sections" if kind == "crater" else "trajectories of the centre"
-    fig.suptitle(f"{study.name}: {what}")
-    return fig

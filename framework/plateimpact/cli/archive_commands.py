@@ -21,8 +21,9 @@ from ..errors import PluginError
 from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
+from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE
 from ..study import Study, StudyResults
-from .common import UsageError, check_directory
+from .common import UsageError, check_directory, dots_per_inch
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
 
@@ -42,6 +43,13 @@ def add_parsers(sub: Any) -> None:
     )
     rerun.add_argument(
         "--as", dest="tag", metavar="TAG", help="store the new runs as VARIANT@TAG beside the old"
+    )
+    _add_dpi(p)
+    p.add_argument(
+        "--format",
+        choices=("png", "svg", "pdf"),
+        default="png",
+        help="the figures' format (default: png; svg and pdf are vector, for print)",
     )
     p.set_defaults(command_function=reproduce_command)
 
@@ -83,7 +91,13 @@ def add_parsers(sub: Any) -> None:
     )
     p.add_argument("archive", help="HDF5 archive")
     p.add_argument("--run", required=True, action="append", help="run name (repeat to overlay)")
-    p.add_argument("--out", required=True, metavar="FILE.png", help="where to draw")
+    p.add_argument(
+        "--out",
+        required=True,
+        metavar="FILE",
+        help="where to draw; the format from the extension (.png, .svg, .pdf, ...)",
+    )
+    _add_dpi(p)
     p.add_argument(
         "--kind",
         choices=("exit", "trajectory", "crater"),
@@ -100,6 +114,16 @@ def add_parsers(sub: Any) -> None:
         "default: six spread over the range)",
     )
     p.set_defaults(command_function=plot_command)
+
+
+def _add_dpi(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--dpi",
+        type=dots_per_inch,
+        default=FIGURE_DPI,
+        help=f"resolution of raster figures, {FIGURE_DPI_RANGE[0]:g}-{FIGURE_DPI_RANGE[1]:g} "
+        f"dots per inch (default: {FIGURE_DPI:g}; study figures are 7.2 in wide)",
+    )
 
 
 #: The entry-point group of runnable study collections; ``reproduce`` runs ``report``.
@@ -143,7 +167,9 @@ def reproduce_command(args: argparse.Namespace) -> None:
     if args.tag is not None and not _printable_tag(args.tag):
         raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
     try:
-        archive, figures = reproduce(out, None, args.resume, args.overwrite, args.tag)
+        archive, figures = reproduce(
+            out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format
+        )
     except RunExistsError as exc:
         raise UsageError(
             f"{str(exc).split(':', 1)[0]}: --resume keeps it (runs only what is missing), "
@@ -228,6 +254,7 @@ def compare_command(args: argparse.Namespace) -> None:
 
 def plot_command(args: argparse.Namespace) -> None:
     from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..path_figures import plot_study_paths  # noqa: PLC0415
 
     check_directory(args.out, "--out", "figure")
     for speed in args.speed or ():
@@ -238,8 +265,8 @@ def plot_command(args: argparse.Namespace) -> None:
         figure = plotting.plot_study(results)
     else:
         try:
-            figure = plotting.plot_study_paths(results, kind=args.kind, speeds=args.speed)
+            figure = plot_study_paths(results, kind=args.kind, speeds=args.speed)
         except ValueError as exc:
             raise UsageError(str(exc)) from None
-    plotting.save(figure, args.out, "--out")
+    plotting.save(figure, args.out, "--out", dpi=args.dpi)
     print(f"figure: {args.out}")

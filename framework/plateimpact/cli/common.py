@@ -5,12 +5,13 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import math
 import sys
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
-from ..storage.output import OutputError, check_output, write_text
+from ..storage.output import FIGURE_DPI_RANGE, OutputError, check_output, write_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -37,6 +38,21 @@ def check_directory(path: str | None, flag: str, kind: str = "csv") -> None:
     regular file, read-only, a figure format matplotlib cannot write)."""
     if path is not None:
         check_output(path, flag, kind)
+
+
+def dots_per_inch(text: str) -> float:
+    """The value of ``--dpi``: a resolution [dots per inch] within FIGURE_DPI_RANGE (argparse
+    names the flag in the one-line error)."""
+    low, high = FIGURE_DPI_RANGE
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not low <= value <= high:  # NaN fails too
+        raise argparse.ArgumentTypeError(
+            f"must be a number from {low:g} to {high:g} dots per inch, got {text!r}"
+        )
+    return value
 
 
 def write_atomically(path: str, text: str, flag: str) -> None:

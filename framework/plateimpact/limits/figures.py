@@ -19,33 +19,19 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
-from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
-from ..plotting import figure
+from ..plotting import figure, regime_colour, regime_key
 from .find import Limits
 from .lines import OBLIQUITY
 from .maps import OutcomeMap
 from .regimes import REGIMES, Regime
 
-#: One colour per regime; the thin-plate band (ricochet after failure) stands out.
-REGIME_COLOURS = {
-    REGIMES[0]: "#4c72b0",  # ricochet
-    REGIMES[1]: "#a05fc0",  # ricochet after failure
-    REGIMES[2]: "#dd8452",  # embedment
-    REGIMES[3]: "#e6c85a",  # embedment after failure
-    REGIMES[4]: "#55a868",  # perforation
-}
 _DEG = math.pi / 180.0
 
 
-def _colour(regime: Regime) -> str:
-    return REGIME_COLOURS.get(regime, "#999999")
-
-
 def _key(ax: Axes, regimes: Sequence[Regime], **kwargs: Any) -> None:
-    handles = [Patch(color=_colour(r), label=r.label) for r in REGIMES if r in regimes]
-    ax.legend(handles=handles, fontsize="small", **kwargs)
+    ax.legend(handles=regime_key(regimes), fontsize="small", **kwargs)
 
 
 def _model_line(model: dict[str, object]) -> str:
@@ -64,7 +50,7 @@ def plot_bands(found: Limits, label: str) -> Figure:
             seen.add(band.regime)
             ax.broken_barh(
                 [(band.start / scale, band.width / scale)], (k - 0.4, 0.8),
-                facecolors=_colour(band.regime),
+                facecolors=regime_colour(band.regime),
             )  # fmt: skip
         marks = [(line.ballistic_limit, "k"), (line.ricochet_limit, "w")]
         if not along_speed:
@@ -95,10 +81,12 @@ def draw_outcome_map(ax: Axes, found: OutcomeMap, label: str) -> None:
     """The map of ``found`` on ``ax``: regimes, boundaries, exit-speed contours."""
     codes = [r.code for r in REGIMES]
     index = np.searchsorted(codes, found.regime)  # regime code -> colour index
-    cmap = ListedColormap([_colour(r) for r in REGIMES])
+    cmap = ListedColormap([regime_colour(r) for r in REGIMES])
     norm = BoundaryNorm(np.arange(len(REGIMES) + 1) - 0.5, len(REGIMES))
     degrees = found.obliquities / _DEG
-    ax.pcolormesh(found.speeds, degrees, index, cmap=cmap, norm=norm, shading="nearest")
+    # A raster even in SVG and PDF (thousands of cells); boundaries and labels stay vector.
+    ax.pcolormesh(found.speeds, degrees, index, cmap=cmap, norm=norm, shading="nearest",
+                  rasterized=True)  # fmt: skip
     top = float(np.nanmax(found.exit_speed))
     levels = np.asarray(MaxNLocator(8).tick_values(0.0, top))[1:]
     levels = levels[levels < top]
