@@ -1,16 +1,27 @@
-"""Provenance: the source commit comes from the installed distribution's
-direct_url.json (PEP 610), never from a repository that merely encloses site-packages."""
+"""Provenance: every output carries every input, in user units, and the source commit.
+
+The commit comes from the installed distribution's direct_url.json (PEP 610), never
+from a repository that merely encloses site-packages; ``run --json`` reruns bit for bit
+from its own output alone.
+"""
 
 from __future__ import annotations
 
 import importlib.metadata
 import json
+import math
 import os
 import subprocess
 
+import numpy as np
 import pytest
 
+import plateimpact as pi
+from plateimpact.bodies import MASS
+from plateimpact.cli import main
+from plateimpact.scene import IMPACT_OBLIQUITY
 from plateimpact.storage import provenance
+from plateimpact.storage.plate_file import plate_from_dict, plate_to_dict
 
 # -- the source commit ---------------------------------------------------------------
 
@@ -127,3 +138,142 @@ def test_a_source_tree_on_the_path_gives_its_own_checkouts_commit(tmp_path, inst
     assert provenance.source_commit(tmp_path / "elsewhere" / "lib" / "plateimpact") == "unknown"
     install(None)  # not installed at all
     assert provenance.source_commit(tmp_path / "tree" / "framework" / "plateimpact") == head
+
+
+# -- exact numbers in user units ------------------------------------------------------
+
+
+def test_user_numbers_parse_back_to_the_same_double_and_are_as_short_as_typed():
+    rng = np.random.default_rng(17)
+    for declared in (MASS, IMPACT_OBLIQUITY):
+        for typed in [
+            f"{x:.{d}g}"
+            for x, d in zip(rng.uniform(0.01, 80, 300), rng.integers(1, 17, 300), strict=True)
+        ]:
+            si = declared.parse(typed)
+            found = declared.user_number(si)
+            assert found is not None and found * declared.scale == si, typed
+            assert len(repr(found)) <= len(repr(float(typed))), (typed, found)
+        for si in rng.uniform(1e-4, 1.5, 300):  # computed in SI: exact or refused
+            found = declared.user_number(float(si))
+            neighbours = [si / declared.scale]
+            for direction in (math.inf, -math.inf):
+                for _ in range(8):
+                    neighbours.append(math.nextafter(neighbours[-1], direction))
+                neighbours.append(si / declared.scale)
+            reachable = any(v * declared.scale == si for v in neighbours)
+            assert (found is not None) == reachable
+            assert found is None or found * declared.scale == si
+
+
+def test_plate_files_round_trip_exactly():
+    plate = pi.presets.plate("2024-T3/3.18").with_constants(
+        critical_penetration=2.7e-3, failure_angle=np.radians(40.0)
+    )
+    data = plate_to_dict(plate)
+    assert data["alpha_deg"] == 40 and data["pstar_mm"] == 2.7 and data["thickness_mm"] == 3.18
+    assert plate_from_dict(json.loads(json.dumps(data))) == plate  # the same bits
+
+
+# -- run --json and --inputs ----------------------------------------------------------
+
+RUN = ["run", "--preset", "2024-T3/3.18", "--speed", "640", "--obliquity", "60"]
+CUSTOM = [
+    "--radius", "3", "--mass", "0.9", "--a", "1.1e9", "--b", "1300", "--pstar", "2.7",
+    "--alpha", "40", "--failure", "hinge", "--set", "failure.finger_area_scale=0.7",
+    "--rtol", "1e-9", "--set", "model.rest_speed_fraction=0.02",
+]  # fmt: skip
+
+
+def run_json(capsys, *args: str) -> str:
+    assert main([*args, "--json"]) == 0
+    return capsys.readouterr().out
+
+
+def test_run_json_records_every_input_as_typed(capsys):
+    inputs = json.loads(run_json(capsys, *RUN, *CUSTOM))["inputs"]
+    assert inputs["impact_speed_m_s"] == 640 and inputs["impact_obliquity_deg"] == 60
+    assert inputs["sphere"] == {"radius_mm": 3, "mass_g": 0.9}
+    plate = inputs["plate"]
+    assert (plate["material"], plate["thickness_mm"], plate["a_N_m2"], plate["b_kg_m3"]) == (
+        "2024-T3",
+        3.18,
+        1.1e9,
+        1300,
+    )
+    assert (plate["pstar_mm"], plate["alpha_deg"]) == (2.7, 40)
+    model = inputs["model"]
+    assert (model["resistance"], model["failure"], model["integrator"]) == (
+        "poncelet",
+        "hinge",
+        "dopri5",
+    )
+    assert model["failure_settings"]["finger_area_scale"] == 0.7
+    assert model["integrator_settings"]["rtol"] == 1e-9
+    assert model["rest_speed_fraction"] == 0.02
+    assert set(inputs["versions"]) >= {"python", "plateimpact", "numpy", "scipy"}
+    assert inputs["source_commit"] == provenance.source_commit()
+
+
+@pytest.mark.parametrize(
+    "options",
+    [CUSTOM, ["--failure", "variable-pstar", "--integrator", "segment", "--step", "2e-3"]],
+    ids=["custom", "variable-pstar"],
+)
+def test_run_json_reruns_bit_for_bit_from_itself_alone(tmp_path, capsys, options):
+    first = run_json(capsys, *RUN, *options)
+    assert (
+        json.loads(first)["exit_speed_m_s"] != json.loads(run_json(capsys, *RUN))["exit_speed_m_s"]
+    )
+    saved = tmp_path / "run.json"
+    saved.write_text(first)
+    assert run_json(capsys, "run", "--inputs", str(saved)) == first  # every byte
+    saved.write_text(json.dumps(json.loads(first)["inputs"]))  # the inputs object alone
+    assert run_json(capsys, "run", "--inputs", str(saved)) == first
+
+
+def test_a_mass_no_gram_value_reaches_is_recorded_in_kg(tmp_path, capsys):
+    """A new radius keeps the default density: its mass is computed in SI, and some masses
+    lie between the numbers of grams that * 1e-3 can reach."""
+    radius = next(
+        r
+        for r in np.round(np.arange(2.0, 4.0, 0.01), 2)
+        if MASS.user_number(pi.Sphere.of_density(r * 1e-3, pi.presets.SAE_52100_DENSITY).mass)
+        is None
+    )
+    first = run_json(capsys, *RUN, "--radius", str(radius))
+    sphere = json.loads(first)["inputs"]["sphere"]
+    assert set(sphere) == {"radius_mm", "mass_kg"}
+    (tmp_path / "run.json").write_text(first)
+    assert run_json(capsys, "run", "--inputs", str(tmp_path / "run.json")) == first
+
+
+@pytest.mark.parametrize(
+    ("change", "named"),
+    [
+        (lambda d: d["inputs"]["sphere"].update(radius_in=0.1), "sphere.radius_in: unknown key"),
+        (lambda d: d["inputs"]["sphere"].update(radius_m=0.003), "radius_mm or radius_m, not both"),
+        (lambda d: d["inputs"].pop("impact_speed_m_s"), "impact_speed_m_s: missing"),
+        (lambda d: d["inputs"]["model"]["integrator_settings"].update(rtol="x"), "rtol"),
+        (lambda d: d["inputs"]["plate"].update(pstar_mm=-1), "pstar_mm"),
+        (lambda d: d["inputs"]["model"].update(failure="shatter"), "shatter"),
+        (lambda d: d.update(inputs={"format": "x"}), "not a plateimpact inputs record"),
+    ],
+)
+def test_a_bad_inputs_file_is_one_line_naming_the_key(tmp_path, capsys, change, named):
+    data = json.loads(run_json(capsys, *RUN))
+    change(data)
+    (tmp_path / "run.json").write_text(json.dumps(data))
+    assert main(["run", "--inputs", str(tmp_path / "run.json")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "run.json" in err and named in err, err
+
+
+def test_inputs_with_scene_or_model_options_is_refused(tmp_path, capsys):
+    (tmp_path / "run.json").write_text(run_json(capsys, *RUN))
+    for extra in (["--speed", "700"], ["--failure", "plugging"], ["--rtol", "1e-9"]):
+        assert main(["run", "--inputs", str(tmp_path / "run.json"), *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"--inputs cannot be combined with {extra[0]}" in err
+    assert main(["run", "--preset", "2024-T3/3.18", "--speed", "640"]) == 2
+    assert "--obliquity" in capsys.readouterr().err

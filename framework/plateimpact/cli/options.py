@@ -28,6 +28,12 @@ from .common import UsageError
 
 #: The model slots ``--set`` knows besides the plug-in kinds.
 SET_SLOTS = (*KINDS, "model", "plate")
+#: The plug-in of each kind when none is named.
+DEFAULT_NAMES = {
+    "resistance": DEFAULT_RESISTANCE,
+    "failure": DEFAULT_FAILURE,
+    "integrator": DEFAULT_INTEGRATOR,
+}
 #: Which flag named which parameter, for error messages: set while arguments are read.
 TYPED_FLAGS = "_typed_flags"
 
@@ -61,16 +67,10 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
     group = parser.add_argument_group(
         "model (plug-ins by name; see 'plateimpact plugins --details')"
     )
-    defaults = {
-        "resistance": DEFAULT_RESISTANCE,
-        "failure": DEFAULT_FAILURE,
-        "integrator": DEFAULT_INTEGRATOR,
-    }
-    for kind, default in defaults.items():
+    for kind, default in DEFAULT_NAMES.items():
         choices = ", ".join(registry.names(kind))
-        group.add_argument(
-            f"--{kind}", default=default, help=f"{kind}: {choices} (default {default})"
-        )
+        # No argparse default: a command can tell a name typed from none (run --inputs).
+        group.add_argument(f"--{kind}", help=f"{kind}: {choices} (default {default})")
     group.add_argument(
         "--set",
         action="append",
@@ -147,7 +147,11 @@ class ModelChoice:
 
     def __init__(self, args: argparse.Namespace, registry: PluginRegistry) -> None:
         self.registry = registry
-        self.names = {kind: getattr(args, kind) for kind in KINDS}
+        typed_names = {kind: getattr(args, kind, None) for kind in KINDS}
+        self.names = {
+            kind: DEFAULT_NAMES[kind] if name is None else name
+            for kind, name in typed_names.items()
+        }
         self.settings: dict[str, dict[str, Any]] = {kind: {} for kind in KINDS}
         self.model: dict[str, Any] = {}
         self.plate: dict[str, float] = {}

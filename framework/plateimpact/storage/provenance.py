@@ -1,5 +1,5 @@
-"""Provenance: what a run records besides its numbers: the versions, the source commit,
-the host and times (docs/archive.md)."""
+"""Provenance: what a run records besides its numbers: its inputs, the versions and the
+source commit (docs/archive.md)."""
 
 from __future__ import annotations
 
@@ -10,14 +10,19 @@ import platform
 import socket
 import subprocess
 import time
+from collections.abc import Mapping
 from importlib import metadata as importlib_metadata
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlparse
 from urllib.request import url2pathname
 
+from ..bodies import Plate, Sphere
+from ..parameters import Parameter
 from ..simulation import Simulation
 from ..variant import Variant
+from . import inputs
+from .plate_file import plate_to_dict
 
 PACKAGES = ("plateimpact", "numpy", "scipy", "attrs", "pluggy", "h5py")
 
@@ -128,6 +133,37 @@ def versions() -> dict[str, str]:
         except importlib_metadata.PackageNotFoundError:
             found[package] = "unknown"
     return found
+
+
+def inputs_record(
+    simulation: Simulation,
+    sphere: Sphere | None = None,
+    plate: Plate | None = None,
+    *,
+    label: str | None = None,
+    scene: Mapping[Parameter, float] | None = None,
+    **extra: object,
+) -> dict[str, Any]:
+    """Every input of a run, in user units, and where the code came from (storage.inputs:
+    the format; ``run --inputs`` reads it back). ``scene`` gives values [SI] by
+    declaration (impact speed and obliquity of one scene); ``extra`` adds keys as they
+    are (a sweep's grid as typed). Without a sphere and plate (a study's runs, whose
+    scenes are stored beside them): the model and provenance only."""
+    record: dict[str, Any] = {"format": inputs.FORMAT}
+    if label is not None:
+        record["label"] = label
+    for declared, value in (scene or {}).items():
+        key, number = inputs.quantity(declared, value)
+        record[key] = number
+    record.update(extra)
+    if sphere is not None:
+        record["sphere"] = inputs.sphere_record(sphere)
+    if plate is not None:
+        record["plate"] = plate_to_dict(plate)
+    record["model"] = inputs.model_record(simulation)
+    record["versions"] = versions()
+    record["source_commit"] = source_commit()
+    return record
 
 
 class RunMetadata:
