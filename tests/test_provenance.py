@@ -2,12 +2,14 @@
 
 The commit comes from the installed distribution's direct_url.json (PEP 610), never
 from a repository that merely encloses site-packages; ``run --json`` reruns bit for bit
-from its own output alone.
+from its own output alone; a sweep's CSV has its inputs beside it.
 """
 
 from __future__ import annotations
 
+import csv
 import importlib.metadata
+import io
 import json
 import math
 import os
@@ -277,3 +279,34 @@ def test_inputs_with_scene_or_model_options_is_refused(tmp_path, capsys):
         assert err.count("\n") == 1 and f"--inputs cannot be combined with {extra[0]}" in err
     assert main(["run", "--preset", "2024-T3/3.18", "--speed", "640"]) == 2
     assert "--obliquity" in capsys.readouterr().err
+
+
+# -- the sweep's sidecar ----------------------------------------------------------------
+
+SWEEP = ["sweep", "--preset", "SAE1010/1.47", "--speeds", "300:900:3", "--obliquities", "0,45"]
+
+
+def test_a_sweep_csv_has_its_inputs_beside_it_and_each_row_reruns(tmp_path, capsys):
+    target = tmp_path / "steel.csv"
+    assert main([*SWEEP, "--radius", "2.5", "--failure", "hinge", "--csv", str(target)]) == 0
+    assert str(target) + ".json" in capsys.readouterr().out
+    rows = list(csv.DictReader(target.open()))
+    record = json.loads((tmp_path / "steel.csv.json").read_text())
+    assert (record["speeds_m_s"], record["obliquities_deg"]) == ("300:900:3", "0,45")
+    assert record["sphere"]["radius_mm"] == 2.5 and record["model"]["failure"] == "hinge"
+    for row in (rows[1], rows[5]):
+        scene = {k: v for k, v in record.items() if k not in ("speeds_m_s", "obliquities_deg")}
+        scene["impact_speed_m_s"] = float(row["impact_speed_m_s"])
+        scene["impact_obliquity_deg"] = float(row["impact_obliquity_deg"])
+        (tmp_path / "scene.json").write_text(json.dumps(scene))
+        rerun = json.loads(run_json(capsys, "run", "--inputs", str(tmp_path / "scene.json")))
+        assert rerun["outcome"] == row["outcome"]
+        assert rerun["exit_speed_m_s"] == float(row["exit_speed_m_s"])  # SI: the same bits
+
+
+def test_a_sweep_to_standard_output_prints_only_its_csv(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(SWEEP) == 0
+    rows = list(csv.reader(io.StringIO(capsys.readouterr().out)))
+    assert len(rows) == 1 + 6 and rows[0][0] == "preset"
+    assert list(tmp_path.iterdir()) == []

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..batch import SceneBatch
+from ..bodies import Plate, Sphere
 from ..crater import crater_section
 from ..parameters import Parameter
 from ..registry import PluginRegistry, default_registry
@@ -229,8 +230,31 @@ def _parse_obliquities(text: str) -> np.ndarray:
         raise UsageError(f"--obliquities must be a comma list in degrees, got {text!r}") from None
 
 
+def sidecar(csv_path: str) -> str:
+    """Where a sweep's inputs and provenance go beside its CSV: FILE.json for --csv FILE
+    (the CSV stays plain for any CSV reader)."""
+    return f"{csv_path}.json"
+
+
+def write_sweep_inputs(
+    args: argparse.Namespace, simulation: Simulation, sphere: Sphere, plate: Plate, label: str
+) -> None:
+    """The inputs record of a sweep (storage.provenance), beside its --csv file."""
+    record = inputs_record(
+        simulation,
+        sphere,
+        plate,
+        label=label,
+        speeds_m_s=args.speeds,
+        obliquities_deg=args.obliquities,
+    )
+    write_atomically(sidecar(args.csv), json.dumps(record, indent=2) + "\n", "--csv")
+    print(f"inputs and provenance: {sidecar(args.csv)}")
+
+
 def sweep_command(args: argparse.Namespace) -> None:
     check_directory(args.csv, "--csv")
+    check_directory(args.csv and sidecar(args.csv), "--csv", "json")
     scene_flags(args, "--speeds", "--obliquities")
     choice = model_choice(args)
     simulation = choice.simulation()
@@ -270,3 +294,4 @@ def sweep_command(args: argparse.Namespace) -> None:
         f"wrote {len(result)} scenes to {args.csv}: "
         + ", ".join(f"{counts[o]} {o.label}" for o in Outcome)
     )
+    write_sweep_inputs(args, simulation, sphere, plate, label)
