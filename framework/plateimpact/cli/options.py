@@ -266,11 +266,38 @@ def bodies(
         thickness = overrides.pop("thickness")
         return sphere_of(args), Plate("custom", thickness, overrides), "custom"
     if "thickness" in overrides:
+        _check_new_thickness(base, label, overrides, flags, needed)
         base = attrs.evolve(base, thickness=overrides.pop("thickness"))
     if flags:
         base = Plate(base.material, base.thickness, {**base.constant_values(), **overrides})
         label = f"{label}+custom"
     return sphere_of(args), base, label
+
+
+def _check_new_thickness(
+    preset: Plate,
+    label: str,
+    overrides: dict[str, float],
+    flags: dict[str, str],
+    needed: dict[str, Parameter],
+) -> None:
+    """Refuse a preset's plate at another thickness without its constants: the model has
+    no back surface, T enters only through a, b, P*, ... fitted at the preset's T
+    (docs/model.md, "The plate thickness"), so a new T alone would change nothing."""
+    thickness = overrides["thickness"]
+    missing = [
+        p.flag or f"--set plate.{p.name}"
+        for p in needed.values()
+        if not p.has_default and p.name not in overrides
+    ]
+    if thickness == preset.thickness or not missing:
+        return
+    raise UsageError(
+        f"{flags['thickness']}: the model uses T only to bound craters; a thickness acts "
+        f"through the plate constants, and {label}'s were fitted at "
+        f"{THICKNESS.format(preset.thickness)} mm: give {', '.join(missing)} for "
+        f"{THICKNESS.format(thickness)} mm too, or fit them with 'plateimpact calibrate'"
+    )
 
 
 def scene_flags(args: argparse.Namespace, speed_flag: str, obliquity_flag: str) -> None:
