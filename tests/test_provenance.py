@@ -2,7 +2,8 @@
 
 The commit comes from the installed distribution's direct_url.json (PEP 610), never
 from a repository that merely encloses site-packages; ``run --json`` reruns bit for bit
-from its own output alone; a sweep's CSV has its inputs beside it.
+from its own output alone; a sweep's CSV has its inputs beside it; ``show`` prints a
+run's model, scenes, versions and commit.
 """
 
 from __future__ import annotations
@@ -310,3 +311,25 @@ def test_a_sweep_to_standard_output_prints_only_its_csv(tmp_path, capsys, monkey
     rows = list(csv.reader(io.StringIO(capsys.readouterr().out)))
     assert len(rows) == 1 + 6 and rows[0][0] == "preset"
     assert list(tmp_path.iterdir()) == []
+
+
+# -- show -------------------------------------------------------------------------------
+
+
+def test_show_prints_a_runs_inputs_and_provenance(tmp_path, capsys):
+    path = tmp_path / "a.h5"
+    variant = pi.Variant(
+        "finger", failure="hinge", failure_settings={"finger_area_scale": 0.5},
+        integrator_settings={"rtol": 1e-9},
+    )  # fmt: skip
+    pi.Study.grid("s", ["2024-T3/3.18"], [0, 45], [300.0, 600.0], [variant]).run(archive=path)
+    meta = pi.Archive(path).metadata("finger")
+    assert main(["show", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "failure: hinge 1 (finger_area_scale 0.5, hinge_obliquity none)" in out
+    assert "rtol 1e-09" in out and "max_seconds 20 s" in out
+    assert f"source commit {meta['git_commit']}" in out
+    for name, version in meta["versions"].items():
+        assert f"{name} {version}" in out
+    assert "plates 2024-T3/3.18" in out and "impact_obliquity 0 deg, 45 deg" in out
+    assert "thickness 3.18 mm" in out and "critical_penetration 3 mm" in out
