@@ -8,6 +8,7 @@ import json
 import subprocess
 import sys
 
+import attrs
 import numpy as np
 import pytest
 
@@ -184,6 +185,25 @@ def test_malformed_arguments_are_one_line_and_exit_2(args, capsys):
     assert info.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("plateimpact: error: ")
+
+
+def test_a_presets_thickness_alone_is_refused_as_it_would_change_nothing(capsys):
+    """T is in no force law: a, b, P*, alpha* carry it, fitted at the preset's T."""
+    for changed in (["--thickness", "5"], ["--set", "plate.thickness=5"]):
+        assert main([*RUN, *changed]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(f"plateimpact: error: {changed[0]}")
+        assert "fitted at 6.35 mm: give --a, --b, --pstar, --alpha for 5 mm" in err
+        assert "plateimpact calibrate" in err
+    assert main([*RUN, "--thickness", "5", "--a", "1e9", "--failure", "intact"]) == 2
+    assert "give --b for 5 mm" in capsys.readouterr().err  # only what the model reads
+    constants = ["--a", "1e9", "--b", "1200", "--pstar", "4", "--alpha", "45"]
+    assert main([*RUN, "--thickness", "6.35", "--json"]) == 0  # the preset's own: no change
+    assert json.loads(capsys.readouterr().out)["inputs"]["plate"]["thickness_mm"] == 6.35
+    assert main([*RUN, "--thickness", "5", *constants, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["inputs"]["plate"]["thickness_mm"] == 5
+    thin = presets.plate("2024-T3/6.35")
+    assert attrs.evolve(thin, thickness=5e-3).thickness == 5e-3  # the API keeps its Plate
 
 
 def test_custom_plate_needs_every_plate_option(capsys):

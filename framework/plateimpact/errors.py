@@ -48,6 +48,11 @@ class PlateFileError(PlateImpactError, ValueError):
     """A plate file cannot be read or holds an invalid plate."""
 
 
+class InputsError(PlateImpactError, ValueError):
+    """An inputs record (``run --json``) cannot be read back; the message names the file
+    and the key."""
+
+
 class CalibrationError(PlateImpactError, RuntimeError):
     """No a, b can be found from the shots: too few perforations, a DRI fit outside the
     model's range, or an iteration that did not converge."""

@@ -177,6 +177,26 @@ class Parameter:
             return _fmt(float(value) / self.scale) if self.kind is float else str(value)
         return str(self.json_value(value))
 
+    def user_number(self, value: float) -> float | None:
+        """``value`` [SI] in the user's unit, as the shortest number that :meth:`parse`
+        turns back into exactly ``value`` (``45``, not ``45.00000000000001``); None if no
+        number does (about 2% of values computed in SI, e.g. a mass from a density, fall
+        between the numbers a unit of 1e-3 can reach)."""
+        value = float(value)
+        if self.scale == 1.0 or not math.isfinite(value):
+            return value
+        naive = value / self.scale
+        candidates = {float(f"{naive:.{digits}g}") for digits in range(1, 18)}
+        for direction in (math.inf, -math.inf):  # the neighbours of the naive quotient
+            neighbour = naive
+            for _ in range(3):
+                neighbour = math.nextafter(neighbour, direction)
+                candidates.add(neighbour)
+        exact = [c for c in candidates if c * self.scale == value]
+        if not exact:
+            return None
+        return min(exact, key=lambda c: (len(repr(c)), abs(c - naive)))
+
     def json_value(self, value: object) -> object:
         """``value`` as a JSON value [SI] (a table becomes its rows)."""
         if self.to_json is not None and value is not None:

@@ -24,6 +24,7 @@ from ..storage.archive import Archive
 from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE
 from ..study import Study, StudyResults
 from .common import UsageError, check_directory, dots_per_inch
+from .describe import run_lines, scene_line
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
 
@@ -199,13 +200,12 @@ def show_command(args: argparse.Namespace) -> None:
     for name in archive.runs():
         meta: dict[str, Any] = archive.metadata(name)
         result: BatchResult = archive.results(name)
-        variant = meta["variant"]
         counts = np.bincount(result.outcome, minlength=4)[1:]
         print(f"{name}")
-        print(
-            f"  model: {variant['resistance']} + {variant['failure']}, "
-            f"integrator {variant['integrator']} {meta['model']['integrator_settings']}"
-        )
+        for line in run_lines(meta):
+            print(line)
+        study = archive.study(name.split("/", 1)[0])
+        print(scene_line(study.scenes, study.plate_labels))
         print(
             f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
             f"{counts[2]} perforation; wall {meta['wall_time_s']:.2f} s"
@@ -217,10 +217,7 @@ def show_command(args: argparse.Namespace) -> None:
         ]
         if kept:
             print(f"  with {' and '.join(kept)}")
-        print(
-            f"  run {meta['start_time']} on {meta['host']}, plateimpact "
-            f"{meta['versions'].get('plateimpact')}, commit {meta['git_commit'][:12]}"
-        )
+        print(f"  run {meta['start_time']} on {meta['host']}")
     show_stored(archive)
 
 

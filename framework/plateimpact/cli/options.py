@@ -28,6 +28,12 @@ from .common import UsageError
 
 #: The model slots ``--set`` knows besides the plug-in kinds.
 SET_SLOTS = (*KINDS, "model", "plate")
+#: The plug-in of each kind when none is named.
+DEFAULT_NAMES = {
+    "resistance": DEFAULT_RESISTANCE,
+    "failure": DEFAULT_FAILURE,
+    "integrator": DEFAULT_INTEGRATOR,
+}
 #: Which flag named which parameter, for error messages: set while arguments are read.
 TYPED_FLAGS = "_typed_flags"
 
@@ -61,16 +67,10 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
     group = parser.add_argument_group(
         "model (plug-ins by name; see 'plateimpact plugins --details')"
     )
-    defaults = {
-        "resistance": DEFAULT_RESISTANCE,
-        "failure": DEFAULT_FAILURE,
-        "integrator": DEFAULT_INTEGRATOR,
-    }
-    for kind, default in defaults.items():
+    for kind, default in DEFAULT_NAMES.items():
         choices = ", ".join(registry.names(kind))
-        group.add_argument(
-            f"--{kind}", default=default, help=f"{kind}: {choices} (default {default})"
-        )
+        # No argparse default: a command can tell a name typed from none (run --inputs).
+        group.add_argument(f"--{kind}", help=f"{kind}: {choices} (default {default})")
     group.add_argument(
         "--set",
         action="append",
@@ -147,7 +147,11 @@ class ModelChoice:
 
     def __init__(self, args: argparse.Namespace, registry: PluginRegistry) -> None:
         self.registry = registry
-        self.names = {kind: getattr(args, kind) for kind in KINDS}
+        typed_names = {kind: getattr(args, kind, None) for kind in KINDS}
+        self.names = {
+            kind: DEFAULT_NAMES[kind] if name is None else name
+            for kind, name in typed_names.items()
+        }
         self.settings: dict[str, dict[str, Any]] = {kind: {} for kind in KINDS}
         self.model: dict[str, Any] = {}
         self.plate: dict[str, float] = {}
@@ -262,11 +266,38 @@ def bodies(
         thickness = overrides.pop("thickness")
         return sphere_of(args), Plate("custom", thickness, overrides), "custom"
     if "thickness" in overrides:
+        _check_new_thickness(base, label, overrides, flags, needed)
         base = attrs.evolve(base, thickness=overrides.pop("thickness"))
     if flags:
         base = Plate(base.material, base.thickness, {**base.constant_values(), **overrides})
         label = f"{label}+custom"
     return sphere_of(args), base, label
+
+
+def _check_new_thickness(
+    preset: Plate,
+    label: str,
+    overrides: dict[str, float],
+    flags: dict[str, str],
+    needed: dict[str, Parameter],
+) -> None:
+    """Refuse a preset's plate at another thickness without its constants: the model has
+    no back surface, T enters only through a, b, P*, ... fitted at the preset's T
+    (docs/model.md, "The plate thickness"), so a new T alone would change nothing."""
+    thickness = overrides["thickness"]
+    missing = [
+        p.flag or f"--set plate.{p.name}"
+        for p in needed.values()
+        if not p.has_default and p.name not in overrides
+    ]
+    if thickness == preset.thickness or not missing:
+        return
+    raise UsageError(
+        f"{flags['thickness']}: the model uses T only to bound craters; a thickness acts "
+        f"through the plate constants, and {label}'s were fitted at "
+        f"{THICKNESS.format(preset.thickness)} mm: give {', '.join(missing)} for "
+        f"{THICKNESS.format(thickness)} mm too, or fit them with 'plateimpact calibrate'"
+    )
 
 
 def scene_flags(args: argparse.Namespace, speed_flag: str, obliquity_flag: str) -> None:

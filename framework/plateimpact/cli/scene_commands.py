@@ -9,10 +9,15 @@ from typing import Any
 import numpy as np
 
 from ..batch import SceneBatch
+from ..bodies import Plate, Sphere
 from ..crater import crater_section
-from ..registry import PluginRegistry
+from ..parameters import Parameter
+from ..registry import PluginRegistry, default_registry
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
+from ..simulation import Simulation
+from ..storage.inputs import load_run_inputs
+from ..storage.provenance import inputs_record
 from .common import (
     UsageError,
     check_directory,
@@ -62,12 +67,22 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         else:
             for declared in (IMPACT_SPEED, IMPACT_OBLIQUITY):
                 flag = declared.flag or ""
-                p.add_argument(flag, required=True, metavar=metavar(declared), help=declared.help())
+                # run checks them itself: --inputs gives them instead
+                required = name != "run"
+                p.add_argument(
+                    flag, required=required, metavar=metavar(declared), help=declared.help()
+                )
         add_body_options(p, registry)
         add_model_options(p, registry)
         p.set_defaults(command_function=function)
     parsers["run"].add_argument("--json", action="store_true", help="print one JSON object")
     parsers["run"].add_argument("--trajectory", metavar="FILE", help="write the trajectory as CSV")
+    parsers["run"].add_argument(
+        "--inputs",
+        metavar="FILE.json",
+        help="run again, bit for bit, the scene a 'run --json' output recorded (its "
+        "'inputs'); no scene, plate, sphere or model option with it",
+    )
     parsers["crater"].add_argument("--csv", metavar="FILE", help="write lateral_mm,depth_mm here")
     parsers["crater"].add_argument("--png", metavar="FILE", help="draw the crater here")
     parsers["sweep"].add_argument("--csv", metavar="FILE", help="write CSV here (default: stdout)")
@@ -84,16 +99,58 @@ def _scene(args: argparse.Namespace) -> tuple[Scene, Any, str]:
     return Scene(sphere, plate, speed, obliquity), simulation, label
 
 
+#: The options of ``run`` that --inputs leaves free: what to print and write.
+_OUTPUT_OPTIONS = ("command", "command_function", "debug", "inputs", "json", "trajectory")
+
+
+def _recorded_scene(args: argparse.Namespace) -> tuple[Scene, Simulation, str]:
+    """The scene, simulation and label of ``run --inputs FILE``."""
+    given = sorted(
+        "--" + dest.replace("_", "-")
+        for dest, value in vars(args).items()
+        if dest not in _OUTPUT_OPTIONS and not dest.startswith("_") and value not in (None, [])
+    )
+    if given:
+        raise UsageError(
+            f"--inputs cannot be combined with {', '.join(given)}: the file gives the whole "
+            "scene and model (edit a copy of it to change one)"
+        )
+    recorded = load_run_inputs(args.inputs, default_registry())
+    return recorded.scene, recorded.simulation, recorded.label
+
+
+def _user(declared: Parameter, scene: Scene) -> float:
+    """A value of the scene in the user's unit, exact where a number there is."""
+    value = getattr(scene, declared.name)
+    exact = declared.user_number(value)
+    return value / declared.scale if exact is None else exact
+
+
 def run_command(args: argparse.Namespace) -> None:
     check_directory(args.trajectory, "--trajectory")
-    scene, simulation, label = _scene(args)
+    if args.inputs is not None:
+        scene, simulation, label = _recorded_scene(args)
+    else:
+        missing = [flag for flag in ("--speed", "--obliquity") if getattr(args, flag[2:]) is None]
+        if missing:
+            raise UsageError(
+                f"the following arguments are required: {', '.join(missing)} (or --inputs)"
+            )
+        scene, simulation, label = _scene(args)
     result = simulation.run(scene, record_trajectory=args.trajectory is not None)
     if args.trajectory is not None and result.trajectory is not None:
         path = result.trajectory
         fields = list(TRAJECTORY_FIELDS.values())
         rows = zip(*(getattr(path, f.name) / f.scale for f in fields), strict=True)
         write_atomically(args.trajectory, csv_text([f.key for f in fields], rows), "--trajectory")
-    speed, obliquity = float(args.speed), float(args.obliquity)
+    inputs = inputs_record(
+        simulation,
+        scene.sphere,
+        scene.plate,
+        label=label,
+        scene={IMPACT_SPEED: scene.impact_speed, IMPACT_OBLIQUITY: scene.impact_obliquity},
+    )
+    speed, obliquity = (_user(d, scene) for d in (IMPACT_SPEED, IMPACT_OBLIQUITY))
     out: dict[str, Any] = {
         "preset": label,
         IMPACT_SPEED.key: speed,
@@ -101,6 +158,7 @@ def run_command(args: argparse.Namespace) -> None:
     }
     out.update(result.as_user_dict())
     out["model"] = simulation.describe()
+    out["inputs"] = inputs
     if args.json:
         print(json.dumps(out))
         return
@@ -172,8 +230,31 @@ def _parse_obliquities(text: str) -> np.ndarray:
         raise UsageError(f"--obliquities must be a comma list in degrees, got {text!r}") from None
 
 
+def sidecar(csv_path: str) -> str:
+    """Where a sweep's inputs and provenance go beside its CSV: FILE.json for --csv FILE
+    (the CSV stays plain for any CSV reader)."""
+    return f"{csv_path}.json"
+
+
+def write_sweep_inputs(
+    args: argparse.Namespace, simulation: Simulation, sphere: Sphere, plate: Plate, label: str
+) -> None:
+    """The inputs record of a sweep (storage.provenance), beside its --csv file."""
+    record = inputs_record(
+        simulation,
+        sphere,
+        plate,
+        label=label,
+        speeds_m_s=args.speeds,
+        obliquities_deg=args.obliquities,
+    )
+    write_atomically(sidecar(args.csv), json.dumps(record, indent=2) + "\n", "--csv")
+    print(f"inputs and provenance: {sidecar(args.csv)}")
+
+
 def sweep_command(args: argparse.Namespace) -> None:
     check_directory(args.csv, "--csv")
+    check_directory(args.csv and sidecar(args.csv), "--csv", "json")
     scene_flags(args, "--speeds", "--obliquities")
     choice = model_choice(args)
     simulation = choice.simulation()
@@ -213,3 +294,4 @@ def sweep_command(args: argparse.Namespace) -> None:
         f"wrote {len(result)} scenes to {args.csv}: "
         + ", ".join(f"{counts[o]} {o.label}" for o in Outcome)
     )
+    write_sweep_inputs(args, simulation, sphere, plate, label)

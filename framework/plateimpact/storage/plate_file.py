@@ -49,7 +49,9 @@ def plate_to_dict(
         declared = by_name.get(name)
         if declared is None:
             raise PlateFileError(f"plate constant {name!r} is declared by no installed plug-in")
-        out[declared.key] = float(f"{value / declared.scale:.15g}")  # 45, not 45.00000000000001
+        # Exact: reading the file gives back the same bits (45, not 45.00000000000001).
+        exact = declared.user_number(value)
+        out[declared.key] = value / declared.scale if exact is None else exact
         units[declared.key] = f"{declared.description} [{declared.user_unit}]"
     out["units"] = units
     out.update(extra or {})
