@@ -218,6 +218,8 @@ def show_command(args: argparse.Namespace) -> None:
         if kept:
             print(f"  with {' and '.join(kept)}")
         print(f"  run {meta['start_time']} on {meta['host']}")
+        data = archive.data_file(name)  # format 2: the run's own netCDF file
+        print(f"  data {data}" if data is not None else "  data in the archive (format 1)")
     show_stored(archive)
 
 
