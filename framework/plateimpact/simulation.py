@@ -9,7 +9,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .batch import SceneBatch
+from .batch import SceneBatch, check_chunk_size
 from .crater import crater_sections
 from .driver import integrate
 from .errors import ParameterError, PluginError
@@ -141,14 +141,6 @@ def _settings(kind: str, settings: object) -> dict[str, Any]:
             f"{kind}_settings", f"{kind}_settings must be a mapping, got {settings!r}"
         )
     return dict(settings)
-
-
-def check_chunk_size(chunk_size: object) -> None:
-    """Scenes per task must be a positive integer."""
-    if not (isinstance(chunk_size, int | np.integer) and chunk_size >= 1):
-        raise ParameterError(
-            "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
-        )
 
 
 def run_chunk(

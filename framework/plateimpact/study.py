@@ -12,14 +12,14 @@ import attrs
 import numpy as np
 
 from . import presets
-from .batch import SceneBatch
+from .batch import SceneBatch, check_chunk_size
 from .bodies import Plate, Sphere
 from .errors import ArchiveWaitWarning, ParameterError, UnknownNameError
 from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult, Outcome
 from .scene import Scene
-from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
+from .simulation import DEFAULT_CHUNK_SIZE, run_chunk
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError
 from .storage.provenance import RunMetadata
