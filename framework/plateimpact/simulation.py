@@ -15,6 +15,7 @@ from .driver import integrate
 from .errors import ParameterError, PluginError
 from .integrator import Integrator
 from .model import REST_SPEED_FRACTION, ImpactModel
+from .progress import report_scenes
 from .registry import PluginRegistry, default_registry
 from .results import BatchResult, Result
 from .scene import Scene
@@ -99,12 +100,15 @@ class Simulation:
         each run as one batch in a worker, and the results come back in order. A scene's
         result does not depend on the rest of its batch, so chunking changes nothing but
         the wall time. Threads gain nothing (the step loop holds the GIL between numpy
-        calls): use processes.
+        calls): use processes. Inside :func:`~plateimpact.progress.reporting_scenes`
+        each finished chunk advances its progress bar.
         """
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
         check_chunk_size(chunk_size)
         if executor is None or batch.size <= chunk_size:
-            return run_chunk(self, batch, record_trajectory, craters)
+            result = run_chunk(self, batch, record_trajectory, craters)
+            report_scenes(batch.size)
+            return result
         bounds = range(0, batch.size, chunk_size)
         futures = [
             executor.submit(
@@ -116,7 +120,11 @@ class Simulation:
             )
             for lo in bounds
         ]
-        return BatchResult.concat([future.result() for future in futures])
+        parts = []
+        for future in futures:
+            parts.append(future.result())
+            report_scenes(len(parts[-1]))
+        return BatchResult.concat(parts)
 
     def run(self, scene: Scene, *, record_trajectory: bool = False) -> Result:
         """The result of one scene."""

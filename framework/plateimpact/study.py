@@ -192,7 +192,8 @@ class Study:
             asked for) is read back instead of run again. Runs are archived only when
             finished, so an interrupted run is simply absent.
         progress : bool or None
-            Progress bar on stderr; None shows it on a terminal only.
+            Progress bar on stderr, once the run has lasted 2 s; None shows it on a
+            terminal only.
         """
         check_chunk_size(chunk_size)
         writer = archive if isinstance(archive, Archive) or archive is None else Archive(archive)
