@@ -14,6 +14,7 @@ import sys
 import numpy as np
 import pytest
 import tqdm.std
+from test_progress import Pipe, Terminal, ticking
 
 import plateimpact as pi
 from plateimpact import presets
@@ -185,27 +186,6 @@ def test_the_help_states_the_limit(capsys):
     assert "more than 1,000,000 scenes" in " ".join(capsys.readouterr().out.split())
 
 
-class Terminal(io.StringIO):
-    def isatty(self) -> bool:
-        return True
-
-
-class Pipe(io.StringIO):
-    def isatty(self) -> bool:
-        return False
-
-
-def ticking(seconds_per_call: float):
-    """A clock for tqdm that advances ``seconds_per_call`` each time it is read."""
-    now = [1000.0]
-
-    def clock() -> float:
-        now[0] += seconds_per_call
-        return now[0]
-
-    return clock
-
-
 @pytest.mark.parametrize(
     ("stderr", "seconds_per_call", "shown"),
     [
@@ -228,15 +208,3 @@ def test_a_progress_bar_on_a_terminal_for_long_runs_only(
         assert "sweep:" in err.getvalue() and "21/21" in err.getvalue()
     else:
         assert err.getvalue() == ""
-
-
-def test_limits_reports_its_passes_on_a_terminal(monkeypatch):
-    monkeypatch.setattr(tqdm.std, "time", ticking(1.0))
-    err = Terminal()
-    monkeypatch.setattr(sys, "stderr", err)
-    argv = ["limits", "--preset", PLATE, "--obliquities", "45", "--resolution", "50",
-            "--tolerance", "1"]  # fmt: skip
-    with contextlib.redirect_stdout(io.StringIO()) as out:
-        assert main(argv) == 0
-    scenes = int(out.getvalue().split(" scenes in ")[0].rsplit(" ", 1)[-1].replace(",", ""))
-    assert f"limits: {scenes}" in err.getvalue().replace(",", "")  # every scene counted

@@ -17,13 +17,14 @@ DELAY = 2.0
 _listening: ContextVar[tqdm | None] = ContextVar("plateimpact_progress", default=None)
 
 
-def progress_bar(total: int | None, label: str, show: bool | None) -> tqdm:
-    """A context-managed bar over ``total`` scene runs (None: a count without a total);
-    ``show=None``: on a terminal only; either way only after :data:`DELAY` seconds."""
+def progress_bar(total: int | None, label: str, show: bool | None, unit: str = "scene") -> tqdm:
+    """A context-managed bar over ``total`` scene runs (or other ``unit``; None: a count
+    without a total); ``show=None``: on a terminal only; either way only after
+    :data:`DELAY` seconds."""
     return tqdm(
         total=total,
         desc=label,
-        unit="scene",
+        unit=unit,
         disable=None if show is None else not show,
         delay=DELAY,
     )

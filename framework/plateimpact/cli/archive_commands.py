@@ -19,6 +19,7 @@ from ..discovery import (
     installed_entry_points,
 )
 from ..errors import PluginError
+from ..progress import progress_bar
 from ..results import BatchResult, Outcome
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
@@ -213,13 +214,17 @@ def plot_command(args: argparse.Namespace) -> None:
     for speed in args.speed or ():
         if not (math.isfinite(speed) and speed > 0.0):
             raise UsageError(f"--speed must be a finite impact speed > 0 m/s, got {speed}")
-    results = _study_results(Archive(args.archive), args.run)
-    if args.kind == "exit":
-        figure = plotting.plot_study(results)
-    else:
-        try:
-            figure = plotting.plot_study_paths(results, kind=args.kind, speeds=args.speed)
-        except ValueError as exc:
-            raise UsageError(str(exc)) from None
-    plotting.save(figure, args.out, "--out")
+    with progress_bar(3, "plot", None, unit="stage") as stages:  # read, draw, save
+        results = _study_results(Archive(args.archive), args.run)
+        stages.update()
+        if args.kind == "exit":
+            figure = plotting.plot_study(results)
+        else:
+            try:
+                figure = plotting.plot_study_paths(results, kind=args.kind, speeds=args.speed)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+        stages.update()
+        plotting.save(figure, args.out, "--out")
+        stages.update()
     print(f"figure: {args.out}")
