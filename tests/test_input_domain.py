@@ -63,7 +63,7 @@ BAD_COMMAND_LINES = [
     (replaced(SWEEP, "--speeds", "inf:1:2"), "--speeds: impact_speed must be in"),
     (replaced(SWEEP, "--speeds", "1:1e200:3"), "--speeds: impact_speed must be in"),
     (replaced(SWEEP, "--speeds", "100,1e200"), "--speeds: impact_speed must be in"),
-    (replaced(SWEEP, "--speeds", "1:2:99999999999"), "--speeds: N must be <= 1000000"),
+    (replaced(SWEEP, "--speeds", "1:2:99999999999"), "--speeds: N must be <= 10,000,000"),
     (replaced(SWEEP, "--obliquities", "nan"), "--obliquities: impact_obliquity must be in"),
     ([*SWEEP, "--mass", "1e-300"], "--mass: "),
     (replaced(CRATER, "--speed", "1e200"), "--speed: "),

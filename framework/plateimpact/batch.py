@@ -7,7 +7,7 @@ see a :class:`SceneBatch`, whose columns are arrays with one entry per scene.
 from __future__ import annotations
 
 import reprlib
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 
 import numpy as np
 
@@ -43,6 +43,14 @@ def _batches(batches: Iterable[SceneBatch]) -> list[SceneBatch]:
         if not isinstance(batch, SceneBatch):
             raise ParameterError("batches", f"expected SceneBatch objects, got {batch!r:.80}")
     return found
+
+
+def check_chunk_size(chunk_size: object) -> None:
+    """Scenes per chunk must be a positive integer."""
+    if not (isinstance(chunk_size, int | np.integer) and chunk_size >= 1):
+        raise ParameterError(
+            "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
+        )
 
 
 class SceneBatch:
@@ -139,13 +147,51 @@ class SceneBatch:
         IMPACT_SPEED.check(speeds)
         IMPACT_OBLIQUITY.check(obliquities)
         obl, spd = np.meshgrid(obliquities, speeds, indexing="ij")
-        n = spd.size
+        return cls._of_impacts(sphere, plate, spd.ravel(), obl.ravel())
+
+    @classmethod
+    def grid_chunks(
+        cls,
+        sphere: Sphere,
+        plate: Plate,
+        speeds: np.ndarray | Iterable[float],
+        obliquities: np.ndarray | Iterable[float],
+        chunk_size: int,
+    ) -> Iterator[SceneBatch]:
+        """The scenes of :meth:`grid`, in its order and with the same values, as batches
+        of ``chunk_size`` scenes (the last one shorter), each built only when asked for:
+        memory holds one chunk, however large the grid. Checked before the first."""
+        check_instance("sphere", sphere, Sphere)
+        check_instance("plate", plate, Plate)
+        speeds = _numbers(IMPACT_SPEED.name, speeds)
+        obliquities = _numbers(IMPACT_OBLIQUITY.name, obliquities)
+        IMPACT_SPEED.check(speeds)
+        IMPACT_OBLIQUITY.check(obliquities)
+        check_chunk_size(chunk_size)
+        return cls._grid_chunks(sphere, plate, speeds, obliquities, int(chunk_size))
+
+    @classmethod
+    def _grid_chunks(
+        cls, sphere: Sphere, plate: Plate, speeds: np.ndarray, obliquities: np.ndarray, size: int
+    ) -> Iterator[SceneBatch]:
+        total = speeds.size * obliquities.size
+        for start in range(0, total, size):
+            row, column = np.divmod(np.arange(start, min(start + size, total)), speeds.size)
+            yield cls._of_impacts(sphere, plate, speeds[column], obliquities[row])
+
+    @classmethod
+    def _of_impacts(
+        cls, sphere: Sphere, plate: Plate, speeds: np.ndarray, obliquities: np.ndarray
+    ) -> SceneBatch:
+        """One sphere and plate at the checked impacts ``speeds`` [m/s], ``obliquities``
+        [rad] (equal lengths)."""
+        n = speeds.size
         columns = {
             "radius": np.full(n, sphere.radius),
             "mass": np.full(n, sphere.mass),
             "thickness": np.full(n, plate.thickness),
-            "impact_speed": spd.ravel(),
-            "impact_obliquity": obl.ravel(),
+            "impact_speed": speeds,
+            "impact_obliquity": obliquities,
         }
         columns.update({name: np.full(n, value) for name, value in plate.constants})
         return cls.of(columns, n)

@@ -9,12 +9,13 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .batch import SceneBatch
+from .batch import SceneBatch, check_chunk_size
 from .crater import crater_sections
 from .driver import integrate
 from .errors import ParameterError, PluginError
 from .integrator import Integrator
 from .model import REST_SPEED_FRACTION, ImpactModel
+from .progress import report_scenes
 from .registry import PluginRegistry, default_registry
 from .results import BatchResult, Result
 from .scene import Scene
@@ -99,12 +100,15 @@ class Simulation:
         each run as one batch in a worker, and the results come back in order. A scene's
         result does not depend on the rest of its batch, so chunking changes nothing but
         the wall time. Threads gain nothing (the step loop holds the GIL between numpy
-        calls): use processes.
+        calls): use processes. Inside :func:`~plateimpact.progress.reporting_scenes`
+        each finished chunk advances its progress bar.
         """
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
         check_chunk_size(chunk_size)
         if executor is None or batch.size <= chunk_size:
-            return run_chunk(self, batch, record_trajectory, craters)
+            result = run_chunk(self, batch, record_trajectory, craters)
+            report_scenes(batch.size)
+            return result
         bounds = range(0, batch.size, chunk_size)
         futures = [
             executor.submit(
@@ -116,7 +120,11 @@ class Simulation:
             )
             for lo in bounds
         ]
-        return BatchResult.concat([future.result() for future in futures])
+        parts = []
+        for future in futures:
+            parts.append(future.result())
+            report_scenes(len(parts[-1]))
+        return BatchResult.concat(parts)
 
     def run(self, scene: Scene, *, record_trajectory: bool = False) -> Result:
         """The result of one scene."""
@@ -141,14 +149,6 @@ def _settings(kind: str, settings: object) -> dict[str, Any]:
             f"{kind}_settings", f"{kind}_settings must be a mapping, got {settings!r}"
         )
     return dict(settings)
-
-
-def check_chunk_size(chunk_size: object) -> None:
-    """Scenes per task must be a positive integer."""
-    if not (isinstance(chunk_size, int | np.integer) and chunk_size >= 1):
-        raise ParameterError(
-            "chunk_size", f"chunk_size must be an integer >= 1, got {chunk_size!r}"
-        )
 
 
 def run_chunk(

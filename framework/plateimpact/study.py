@@ -13,7 +13,7 @@ import attrs
 import numpy as np
 
 from . import presets
-from .batch import SceneBatch
+from .batch import SceneBatch, check_chunk_size
 from .bodies import Plate, Sphere
 from .comparison.ranges import Comparison
 from .errors import ArchiveWaitWarning, ParameterError, UnknownNameError
@@ -21,7 +21,7 @@ from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult
 from .scene import Scene
-from .simulation import DEFAULT_CHUNK_SIZE, check_chunk_size, run_chunk
+from .simulation import DEFAULT_CHUNK_SIZE, run_chunk
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError
 from .storage.provenance import RunMetadata
@@ -221,7 +221,8 @@ class Study:
         run_names : mapping, optional
             Store a variant's run under another name (variant name -> run name).
         progress : bool or None
-            Progress bar on stderr; None shows it on a terminal only.
+            Progress bar on stderr, once the run has lasted 2 s; None shows it on a
+            terminal only.
         """
         check_chunk_size(chunk_size)
         writer = archive if isinstance(archive, Archive) or archive is None else Archive(archive)

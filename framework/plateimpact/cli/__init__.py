@@ -28,7 +28,7 @@ from . import (
 from .common import Parser, UsageError
 from .options import flag_of
 from .reporting import one_line_warnings, report_internal_error
-from .scene_commands import SWEEP_COLUMNS
+from .sweep_csv import SWEEP_COLUMNS
 
 __all__ = ["SWEEP_COLUMNS", "UsageError", "build_parser", "main"]
 

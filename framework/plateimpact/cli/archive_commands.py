@@ -18,6 +18,7 @@ from ..discovery import (
     installed_entry_points,
 )
 from ..errors import PluginError
+from ..progress import progress_bar
 from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
@@ -259,13 +260,17 @@ def plot_command(args: argparse.Namespace) -> None:
     for speed in args.speed or ():
         if not (math.isfinite(speed) and speed > 0.0):
             raise UsageError(f"--speed must be a finite impact speed > 0 m/s, got {speed}")
-    results = _study_results(Archive(args.archive), args.run)
-    if args.kind == "exit":
-        figure = plotting.plot_study(results)
-    else:
-        try:
-            figure = plot_study_paths(results, kind=args.kind, speeds=args.speed)
-        except ValueError as exc:
-            raise UsageError(str(exc)) from None
-    plotting.save(figure, args.out, "--out", dpi=args.dpi)
+    with progress_bar(3, "plot", None, unit="stage") as stages:  # read, draw, save
+        results = _study_results(Archive(args.archive), args.run)
+        stages.update()
+        if args.kind == "exit":
+            figure = plotting.plot_study(results)
+        else:
+            try:
+                figure = plot_study_paths(results, kind=args.kind, speeds=args.speed)
+            except ValueError as exc:
+                raise UsageError(str(exc)) from None
+        stages.update()
+        plotting.save(figure, args.out, "--out", dpi=args.dpi)
+        stages.update()
     print(f"figure: {args.out}")

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..bodies import Plate, Sphere
 from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
+from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..simulation import Simulation
 from ..storage.plate_file import plate_file_text
@@ -70,7 +71,8 @@ def calibrate_command(args: argparse.Namespace) -> None:
     choice.plate.setdefault("b", 1.0)
     sphere, given, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given.thickness, given.constants)
-    report = calibrate(shots, plate, sphere=sphere, simulation=simulation)
+    with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
+        report = calibrate(shots, plate, sphere=sphere, simulation=simulation)
     chosen = report.newton if args.method == "newton" else report.direct
     summary = _summary(args, report, chosen)
     summary["model"] = simulation.describe()

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
+from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome
 from ..storage.archive import Archive
@@ -188,7 +189,10 @@ def limits_command(args: argparse.Namespace) -> None:
             start, stop = _range(args.obliquities, "--obliquities")
             span = (start * _DEG, stop * _DEG)
         find = lim.along_obliquity
-    found = find(simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution)
+    with reporting_scenes("limits"):  # a count of scenes, per pass, on a terminal after 2 s
+        found = find(
+            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution
+        )
     if args.csv is not None:
         write_atomically(args.csv, _csv(found), "--csv")
     if args.png is not None:
@@ -271,8 +275,9 @@ def map_command(args: argparse.Namespace) -> None:
         given.preset = preset
         plates.append(bodies(given, choice, simulation.model))
     spheres = {sphere for sphere, _, _ in plates}  # one, from --radius and --mass
-    found = lim.outcome_maps(simulation, spheres.pop(), [plate for _, plate, _ in plates], span,
-                             samples, rows, tolerance=tolerance)  # fmt: skip
+    with reporting_scenes("map"):
+        found = lim.outcome_maps(simulation, spheres.pop(), [plate for _, plate, _ in plates],
+                                 span, samples, rows, tolerance=tolerance)  # fmt: skip
     maps = [(label, one) for (_, _, label), one in zip(plates, found, strict=True)]
     shape, counted = found[0].shape, found[0].limits
     print(

@@ -8,15 +8,16 @@ from typing import Any
 
 import numpy as np
 
-from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
 from ..crater import crater_section
 from ..parameters import Parameter
+from ..progress import reporting_scenes
 from ..registry import PluginRegistry, default_registry
-from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
+from ..results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
 from ..storage.inputs import load_run_inputs
+from ..storage.output import stream_text
 from ..storage.provenance import inputs_record
 from .common import (
     UsageError,
@@ -34,20 +35,14 @@ from .options import (
     model_choice,
     scene_flags,
 )
+from .sweep_csv import Sweep
 
-#: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
-SWEEP_COLUMNS = (
-    "preset",
-    IMPACT_SPEED.key,
-    IMPACT_OBLIQUITY.key,
-    *(RESULT_FIELDS[name].key for name in ("outcome", "exit_speed", "exit_obliquity")),
-    *(RESULT_FIELDS[name].key for name in ("contact_time", "max_penetration", "plate_failed")),
-)
-
-
-#: The largest sweep: a million scenes take a few minutes and a few hundred MB; a larger
-#: grid belongs in a study, which runs in chunks and keeps what it finished.
+#: The largest sweep without --force: a million scenes take about a minute and a half
+#: (dopri5, one core); a larger grid is refused unless --force says it is meant.
 MAX_SWEEP_SCENES = 1_000_000
+#: The most values one of --speeds, --obliquities may give, --force or not: each list
+#: is held whole (8 bytes a value), the grid never is.
+MAX_SWEEP_VALUES = 10_000_000
 
 
 def add_parsers(sub: Any, registry: PluginRegistry) -> None:
@@ -64,6 +59,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
                 "--speeds", required=True, help="impact speeds [m/s]: START:STOP:N or a list"
             )
             p.add_argument("--obliquities", required=True, help="impact obliquities [deg], a list")
+            p.add_argument(
+                "--force",
+                action="store_true",
+                help=f"run a grid of more than {MAX_SWEEP_SCENES:,} scenes (the results are "
+                "streamed to the output, so memory stays bounded; the time does not)",
+            )
         else:
             for declared in (IMPACT_SPEED, IMPACT_OBLIQUITY):
                 flag = declared.flag or ""
@@ -218,8 +219,8 @@ def _parse_speeds(text: str) -> np.ndarray:
         ) from None
     for end in ends:  # before linspace, which turns an infinite end into NaNs
         IMPACT_SPEED.check(end)
-    if n > MAX_SWEEP_SCENES:
-        raise UsageError(f"--speeds: N must be <= {MAX_SWEEP_SCENES}, got {n}")
+    if n > MAX_SWEEP_VALUES:
+        raise UsageError(f"--speeds: N must be <= {MAX_SWEEP_VALUES:,}, got {n:,}")
     return np.linspace(*ends, n)
 
 
@@ -252,6 +253,16 @@ def write_sweep_inputs(
     print(f"inputs and provenance: {sidecar(args.csv)}")
 
 
+def _check_sweep_size(speeds: int, obliquities: int, force: bool) -> None:
+    """At most MAX_SWEEP_SCENES scenes, unless ``force``."""
+    if speeds * obliquities > MAX_SWEEP_SCENES and not force:
+        raise UsageError(
+            f"--speeds, --obliquities: {speeds:,} x {obliquities:,} = "
+            f"{speeds * obliquities:,} scenes is more than a sweep runs unasked "
+            f"({MAX_SWEEP_SCENES:,}); add --force to run them all"
+        )
+
+
 def sweep_command(args: argparse.Namespace) -> None:
     check_directory(args.csv, "--csv")
     check_directory(args.csv and sidecar(args.csv), "--csv", "json")
@@ -260,38 +271,17 @@ def sweep_command(args: argparse.Namespace) -> None:
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)
     speeds, obliquities = _parse_speeds(args.speeds), _parse_obliquities(args.obliquities)
-    if speeds.size * obliquities.size > MAX_SWEEP_SCENES:
-        raise UsageError(
-            f"--speeds, --obliquities: a sweep runs at most {MAX_SWEEP_SCENES} scenes, got "
-            f"{speeds.size} x {obliquities.size} (run more as a study, in chunks)"
-        )
-    batch = SceneBatch.grid(sphere, plate, speeds, obliquities * IMPACT_OBLIQUITY.scale)
-    result = simulation.run_batch(batch)
-    # Echo the values as typed (the grid is obliquity-major), not their round trip via SI.
-    typed_obliquity = np.repeat(obliquities, speeds.size)
-    typed_speed = np.tile(speeds, obliquities.size)
-    rows = (
-        [
-            label,
-            float(typed_speed[i]),
-            float(typed_obliquity[i]),
-            Outcome(int(result.outcome[i])).label,
-            float(result.exit_speed[i]),
-            float(result.exit_obliquity[i] / RESULT_FIELDS["exit_obliquity"].scale),
-            float(result.contact_time[i]),
-            float(result.max_penetration[i] / RESULT_FIELDS["max_penetration"].scale),
-            bool(result.plate_failed[i]),
-        ]
-        for i in range(len(result))
-    )
-    text = csv_text(SWEEP_COLUMNS, rows)
-    if args.csv is None:
-        write_stdout(text)
-        return
-    write_atomically(args.csv, text, "--csv")
-    counts = np.bincount(result.outcome, minlength=4)
+    _check_sweep_size(speeds.size, obliquities.size, args.force)
+    sweep = Sweep(simulation, sphere, plate, label, speeds, obliquities)
+    texts = sweep.csv_chunks()  # the grid checked: nothing written yet
+    with reporting_scenes("sweep", sweep.size):  # a bar on a terminal, after 2 s
+        if args.csv is None:
+            for text in texts:
+                write_stdout(text)
+            return
+        stream_text(args.csv, texts, "--csv")
     print(
-        f"wrote {len(result)} scenes to {args.csv}: "
-        + ", ".join(f"{counts[o]} {o.label}" for o in Outcome)
+        f"wrote {sweep.size} scenes to {args.csv}: "
+        + ", ".join(f"{sweep.counts[o]} {o.label}" for o in Outcome)
     )
     write_sweep_inputs(args, simulation, sphere, plate, label)

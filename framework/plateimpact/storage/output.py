@@ -19,7 +19,7 @@ import glob
 import os
 import stat
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import IO
 
@@ -45,8 +45,9 @@ class OutputError(PlateImpactError, OSError):
 
 
 def fault_point(stage: str) -> None:
-    """Called at each stage of a write ("open", "write", "fsync", "chmod", "replace"):
-    nothing, unless a test replaces it to fail or crash there deterministically."""
+    """Called at each stage of a write ("open", "write", "fsync", "chmod", "replace"; and
+    "chunk" before each chunk of a streamed file): nothing, unless a test replaces it to
+    fail or crash there deterministically."""
 
 
 def _name_max(directory: str) -> int:
@@ -142,6 +143,22 @@ def write_output(
 def write_text(path: str | os.PathLike[str], text: str, flag: str, kind: str = "csv") -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     return write_output(path, flag, lambda handle: handle.write(text.encode()), kind)
+
+
+def stream_text(
+    path: str | os.PathLike[str], chunks: Iterable[str], flag: str, kind: str = "csv"
+) -> Path:
+    """Write the texts ``chunks`` (UTF-8) to ``path`` as they are made, one at a time, so
+    that memory holds one chunk however long the file; atomically all the same: they go
+    into the temporary file, which replaces the target only after the last one. A failure
+    midway, in writing a chunk or in making one, leaves the old file as it was."""
+
+    def write(handle: IO[bytes]) -> None:
+        for chunk in chunks:
+            fault_point("chunk")
+            handle.write(chunk.encode())
+
+    return write_output(path, flag, write, kind)
 
 
 def pid_alive(pid: int) -> bool:
