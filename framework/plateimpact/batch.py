@@ -53,6 +53,21 @@ def check_chunk_size(chunk_size: object) -> None:
         )
 
 
+def _grid_axes(
+    sphere: Sphere, plate: Plate, speeds: object, obliquities: object
+) -> tuple[np.ndarray, np.ndarray]:
+    """A grid's checked axes: speeds [m/s] and obliquities [rad] as float arrays."""
+    check_instance("sphere", sphere, Sphere)
+    check_instance("plate", plate, Plate)
+    speeds, obliquities = (
+        _numbers(IMPACT_SPEED.name, speeds),
+        _numbers(IMPACT_OBLIQUITY.name, obliquities),
+    )
+    IMPACT_SPEED.check(speeds)
+    IMPACT_OBLIQUITY.check(obliquities)
+    return speeds, obliquities
+
+
 class SceneBatch:
     """Per-scene parameters as 1-D float arrays of equal length.
 
@@ -140,12 +155,7 @@ class SceneBatch:
         Parameters: speeds [m/s]; obliquities [rad]. Built as arrays, without a Scene
         object per point, so that a 10,000-scene sweep costs no Python loop.
         """
-        check_instance("sphere", sphere, Sphere)
-        check_instance("plate", plate, Plate)
-        speeds = _numbers(IMPACT_SPEED.name, speeds)
-        obliquities = _numbers(IMPACT_OBLIQUITY.name, obliquities)
-        IMPACT_SPEED.check(speeds)
-        IMPACT_OBLIQUITY.check(obliquities)
+        speeds, obliquities = _grid_axes(sphere, plate, speeds, obliquities)
         obl, spd = np.meshgrid(obliquities, speeds, indexing="ij")
         return cls._of_impacts(sphere, plate, spd.ravel(), obl.ravel())
 
@@ -161,12 +171,7 @@ class SceneBatch:
         """The scenes of :meth:`grid`, in its order and with the same values, as batches
         of ``chunk_size`` scenes (the last one shorter), each built only when asked for:
         memory holds one chunk, however large the grid. Checked before the first."""
-        check_instance("sphere", sphere, Sphere)
-        check_instance("plate", plate, Plate)
-        speeds = _numbers(IMPACT_SPEED.name, speeds)
-        obliquities = _numbers(IMPACT_OBLIQUITY.name, obliquities)
-        IMPACT_SPEED.check(speeds)
-        IMPACT_OBLIQUITY.check(obliquities)
+        speeds, obliquities = _grid_axes(sphere, plate, speeds, obliquities)
         check_chunk_size(chunk_size)
         return cls._grid_chunks(sphere, plate, speeds, obliquities, int(chunk_size))
 
