@@ -132,6 +132,19 @@ def linked_files(f: h5py.File) -> set[str]:
     return found
 
 
+def _link_count(f: h5py.File) -> int:
+    """How many data files the index ``f`` names: each study's scenes and runs, each
+    record (counted per group, without walking the links)."""
+    count = 0
+    for name in f:
+        group = f[name]
+        if "scenes" in group:
+            count += 1 + len(group.get("runs", ()))
+        else:
+            count += len(group)
+    return count
+
+
 def remove_orphans(real: Path) -> None:
     """Remove what killed writers left: temporaries beside the index and in its data
     directory, and data files no index names. The caller holds the lock."""
@@ -140,11 +153,16 @@ def remove_orphans(real: Path) -> None:
     directory = data_directory(real)
     if not directory.is_dir():
         return
+    present = list(directory.iterdir())
     named = set()
     if real.exists():
-        with h5py.File(real, "r") as f:  # by file name: the index may have been renamed
-            named = {PurePath(target).name for target in linked_files(f)}
-    for path in directory.iterdir():
+        with h5py.File(real, "r") as f:
+            data = [p for p in present if p.suffix == ".nc"]
+            if len(data) == _link_count(f) and not any(p.name.endswith(".tmp") for p in present):
+                return  # one file per link: nothing left behind (the usual case, cheaply)
+            named = {PurePath(target).name for target in linked_files(f)}  # by file name:
+            # the index may have been renamed
+    for path in present:
         orphan = path.name.endswith(".tmp") or (path.suffix == ".nc" and path.name not in named)
         if orphan and path.is_file():
             path.unlink(missing_ok=True)
