@@ -222,6 +222,19 @@ def test_dpi_sets_the_pixels_of_a_journal_width_figure(archive, tmp_path):
         assert height == pytest.approx(sizes[100][1] * dpi / 100, abs=1)
 
 
+def test_every_figure_flag_takes_its_dpi(archive, tmp_path):
+    """A figure without a layout engine is cropped to what is drawn, so its pixels are
+    not dpi x inches: twice the dpi gives about twice the pixels in each direction."""
+    sizes = {}
+    for dpi in (60, 120):
+        png = tmp_path / f"c{dpi}.png"
+        argv = ["crater", "--preset", "2024-T3/3.18", "--speed", "500", "--obliquity", "60",
+                "--png", str(png), f"--dpi={dpi}"]  # fmt: skip
+        assert run_cli(argv)[0] == 0
+        sizes[dpi] = png_size(png)
+    assert sizes[120][0] == pytest.approx(2 * sizes[60][0], rel=0.05)
+
+
 def test_svg_and_pdf_are_written_by_their_extension(archive, tmp_path):
     svg, pdf = tmp_path / "x.svg", tmp_path / "x.pdf"
     for path in (svg, pdf):
@@ -236,7 +249,13 @@ def test_a_bad_dpi_is_one_line_naming_the_flag_and_the_range(archive, tmp_path, 
     for argv in (
         ["plot", str(archive), "--run", "plugging", "--out", str(png), f"--dpi={dpi}"],
         ["reproduce", "--out", str(tmp_path / "report"), f"--dpi={dpi}"],
-    ):
+        ["crater", "--preset", "2024-T3/3.18", "--speed", "500", "--obliquity", "60",
+         "--png", str(png), f"--dpi={dpi}"],
+        ["limits", "--preset", "2024-T3/3.18", "--obliquities", "45", "--png", str(png),
+         f"--dpi={dpi}"],
+        ["map", "--preset", "2024-T3/3.18", "--png", str(png), f"--dpi={dpi}"],
+        ["compare", str(archive), "plugging", "plugging", "--png", str(png), f"--dpi={dpi}"],
+    ):  # fmt: skip
         code, err = run_cli(argv)
         assert code == 2 and err.count("\n") == 1, err
         assert "--dpi" in err and "from 50 to 1200" in err and "Traceback" not in err

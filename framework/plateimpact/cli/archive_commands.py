@@ -22,9 +22,8 @@ from ..progress import progress_bar
 from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
-from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE
 from ..study import Study, StudyResults
-from .common import UsageError, check_directory, dots_per_inch
+from .common import UsageError, add_dpi_option, check_directory
 from .describe import run_lines, scene_line
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
@@ -46,7 +45,7 @@ def add_parsers(sub: Any) -> None:
     rerun.add_argument(
         "--as", dest="tag", metavar="TAG", help="store the new runs as VARIANT@TAG beside the old"
     )
-    _add_dpi(p)
+    add_dpi_option(p)
     p.add_argument(
         "--format",
         choices=("png", "svg", "pdf"),
@@ -74,6 +73,7 @@ def add_parsers(sub: Any) -> None:
         metavar="FILE",
         help="runs: their exit speeds and obliquities overlaid, outcome changes shaded",
     )
+    add_dpi_option(p)
     p.add_argument(
         "--summary",
         action="store_true",
@@ -99,7 +99,7 @@ def add_parsers(sub: Any) -> None:
         metavar="FILE",
         help="where to draw; the format from the extension (.png, .svg, .pdf, ...)",
     )
-    _add_dpi(p)
+    add_dpi_option(p)
     p.add_argument(
         "--kind",
         choices=("exit", "trajectory", "crater"),
@@ -116,16 +116,6 @@ def add_parsers(sub: Any) -> None:
         "default: six spread over the range)",
     )
     p.set_defaults(command_function=plot_command)
-
-
-def _add_dpi(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--dpi",
-        type=dots_per_inch,
-        default=FIGURE_DPI,
-        help=f"resolution of raster figures, {FIGURE_DPI_RANGE[0]:g}-{FIGURE_DPI_RANGE[1]:g} "
-        f"dots per inch (default: {FIGURE_DPI:g}; study figures are 7.2 in wide)",
-    )
 
 
 #: The entry-point group of runnable study collections; ``reproduce`` runs ``report``.
@@ -247,7 +237,7 @@ def compare_command(args: argparse.Namespace) -> None:
         from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
         from ..comparison.figure import plot_comparison  # noqa: PLC0415
 
-        plotting.save(plot_comparison(comparison), args.png, "--png")
+        plotting.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
         if not args.json:
             print(f"figure: {args.png}")
 

@@ -11,7 +11,7 @@ from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
-from ..storage.output import FIGURE_DPI_RANGE, OutputError, check_output, write_text
+from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, OutputError, check_output, write_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -60,11 +60,25 @@ def write_atomically(path: str, text: str, flag: str) -> None:
     write_text(path, text, flag)
 
 
-def save_figure_atomically(fig: Figure, path: str, flag: str = "--png") -> None:
-    """Save a figure to ``path`` (format from its extension), all of it or nothing."""
+def save_figure_atomically(
+    fig: Figure, path: str, flag: str = "--png", dpi: float | None = None
+) -> None:
+    """Save a figure to ``path`` (format from its extension), all of it or nothing;
+    ``dpi`` [dots per inch] for a raster (default: plotting's)."""
     from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
-    plotting.save(fig, path, flag)
+    plotting.save(fig, path, flag, dpi=plotting.DPI if dpi is None else dpi)
+
+
+def add_dpi_option(parser: argparse.ArgumentParser) -> None:
+    """``--dpi N``: the resolution of raster figures, checked before any work."""
+    parser.add_argument(
+        "--dpi",
+        type=dots_per_inch,
+        default=FIGURE_DPI,
+        help=f"resolution of raster figures, {FIGURE_DPI_RANGE[0]:g}-{FIGURE_DPI_RANGE[1]:g} "
+        f"dots per inch (default: {FIGURE_DPI:g}; study figures are 7.2 in wide)",
+    )
 
 
 def write_stdout(text: str) -> None:

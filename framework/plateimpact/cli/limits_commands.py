@@ -16,7 +16,14 @@ from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome
 from ..storage.archive import Archive
-from .common import UsageError, check_directory, csv_text, save_figure_atomically, write_atomically
+from .common import (
+    UsageError,
+    add_dpi_option,
+    check_directory,
+    csv_text,
+    save_figure_atomically,
+    write_atomically,
+)
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
 _DEG = math.pi / 180.0
@@ -51,6 +58,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--csv", metavar="FILE", help="write the bands as CSV")
     p.add_argument("--png", metavar="FILE", help="draw the bands")
+    add_dpi_option(p)
     _add_archive(p, "PRESET_FAILURE")
     add_body_options(p, registry)
     add_model_options(p, registry)
@@ -75,6 +83,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         "ballistic and ricochet limits against obliquity for every --preset",
     )
     p.add_argument("--png", metavar="FILE", required=True, help="draw here")
+    add_dpi_option(p)
     _add_archive(p, "map_PRESET_FAILURE")
     add_body_options(p, registry, many_presets=True)
     add_model_options(p, registry)
@@ -198,7 +207,7 @@ def limits_command(args: argparse.Namespace) -> None:
     if args.png is not None:
         from ..limits.figures import plot_bands  # noqa: PLC0415 (matplotlib when drawing)
 
-        save_figure_atomically(plot_bands(found, label), args.png)
+        save_figure_atomically(plot_bands(found, label), args.png, dpi=args.dpi)
     if args.json:
         print(json.dumps({"preset": label, **found.to_json()}))
     else:
@@ -287,7 +296,7 @@ def map_command(args: argparse.Namespace) -> None:
     from ..limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves
-    save_figure_atomically(draw(maps), args.png)
+    save_figure_atomically(draw(maps), args.png, dpi=args.dpi)
     print(f"figure:  {args.png}")
     failure = simulation.model.failure.name
     for label, drawn in maps:

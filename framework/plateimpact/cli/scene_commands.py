@@ -21,6 +21,7 @@ from ..storage.output import stream_text
 from ..storage.provenance import inputs_record
 from .common import (
     UsageError,
+    add_dpi_option,
     check_directory,
     csv_text,
     save_figure_atomically,
@@ -86,6 +87,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     )
     parsers["crater"].add_argument("--csv", metavar="FILE", help="write lateral_mm,depth_mm here")
     parsers["crater"].add_argument("--png", metavar="FILE", help="draw the crater here")
+    add_dpi_option(parsers["crater"])
     parsers["sweep"].add_argument("--csv", metavar="FILE", help="write CSV here (default: stdout)")
 
 
@@ -202,7 +204,7 @@ def crater_command(args: argparse.Namespace) -> None:
         plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
         speed, obliquity = float(args.speed), float(args.obliquity)
         ax.set_title(f"{label}, {speed:g} m/s at {obliquity:g}°: {result.outcome.label}")
-        save_figure_atomically(fig, args.png)
+        save_figure_atomically(fig, args.png, dpi=args.dpi)
 
 
 def _parse_speeds(text: str) -> np.ndarray:
