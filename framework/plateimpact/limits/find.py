@@ -24,7 +24,7 @@ from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
 from ..storage.plate_file import plate_to_dict
-from ..storage.provenance import versions
+from ..storage.provenance import source_commit, versions
 from .finder import SECTIONS, locate
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
 from .regimes import Regime, regime_codes
@@ -79,6 +79,7 @@ class Limits:
             "lines": [line.to_json() for line in self.lines],
             "scenes": self.scenes,
             "versions": versions(),
+            "source_commit": source_commit(),
         }
 
 
