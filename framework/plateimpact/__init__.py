@@ -77,7 +77,8 @@ _EXPORTS: dict[str, str] = {
     "load_plate_file": "storage.plate_file",
     "save_plate_file": "storage.plate_file",
     "Shots": "storage.shots",
-    "synthetic_shots": "storage.shots",
+    "synthetic_shots": "storage.synthetic_shots",
+    "synthetic_oblique_shots": "storage.synthetic_shots",
     # analysis
     "Study": "study",
     "StudyResults": "study",
@@ -203,7 +204,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .simulation import Simulation, run
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file
-    from .storage.shots import Shots, synthetic_shots
+    from .storage.shots import Shots
+    from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
     from .variant import Variant
 

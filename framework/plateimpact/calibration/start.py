@@ -90,8 +90,13 @@ def model_residual_speeds(
 
 
 def normal_shots(shots: Shots) -> Shots:
-    """The shots at normal incidence, with at least three perforations (ShotDataError)."""
+    """The shots at normal incidence that record a residual speed, with at least three
+    perforations (ShotDataError)."""
     normal = shots.normal_incidence()
+    # A DRI fit reads a residual speed > 0 as a perforation: go/no-go shots (no residual
+    # speed) and a rebound's exit speed tell it nothing.
+    residual = normal.residual_speed
+    normal = normal.take(np.isfinite(residual) & ((residual > 0.0) == normal.perforated))
     perforating = [label for label, p in zip(normal.labels, normal.perforated, strict=True) if p]
     if len(perforating) < MIN_PERFORATIONS:
         listed = f" ({', '.join(perforating)})" if perforating else ""
