@@ -214,3 +214,13 @@ def test_calibration_uses_only_normal_shots_with_a_residual_speed():
     assert list(normal.perforated) == [False, True, True, True]
     with pytest.raises(pi.ShotDataError, match="2 perforating shots at normal incidence"):
         pi.newton_fit(normal, presets.plate("2024-T3/3.18"))
+
+
+def test_the_fits_of_a_and_b_refuse_per_shot_spheres_and_weights_rather_than_ignore_them():
+    rows = "300,0,0,{}\n500,0,300,\n700,0,500,\n900,0,700,\n"
+    for column, value in (("radius_mm", "3"), ("mass_g", "1"), ("weight", "2")):
+        shots = pi.Shots.from_csv_text(
+            f"{HEADER},residual_speed_m_s,{column}\n" + rows.format(value), source="s.csv"
+        )
+        with pytest.raises(pi.ShotDataError, match=r"^s.csv line 2: the fits of a and b take"):
+            pi.newton_fit(shots, presets.plate("2024-T3/3.18"))

@@ -97,6 +97,14 @@ def normal_shots(shots: Shots) -> Shots:
     # speed) and a rebound's exit speed tell it nothing.
     residual = normal.residual_speed
     normal = normal.take(np.isfinite(residual) & ((residual > 0.0) == normal.perforated))
+    # The fits of a and b run one sphere and weigh every shot alike: refuse, not ignore.
+    own = np.isfinite(normal.radius) | np.isfinite(normal.mass) | (normal.weight != 1.0)
+    if own.any():
+        raise ShotDataError(
+            f"{normal.labels[int(np.argmax(own))]}: the fits of a and b take one sphere "
+            "(--radius, --mass) and equal weights: remove radius_mm, mass_g and weight "
+            "from the normal-incidence shots"
+        )
     perforating = [label for label, p in zip(normal.labels, normal.perforated, strict=True) if p]
     if len(perforating) < MIN_PERFORATIONS:
         listed = f" ({', '.join(perforating)})" if perforating else ""
