@@ -111,9 +111,11 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
             if d.distance is not None
             else f"no boundary in {report.speeds[0]:g}-{report.speeds[1]:g} m/s"
         )
+        line = d.label.removeprefix(f"{args.shots} ")  # the file is named above
+        angle = math.degrees(d.impact_obliquity)
         print(
-            f"  {d.label}: {d.impact_speed:g} m/s at {math.degrees(d.impact_obliquity):.6g} "
-            f"deg, measured {d.measured}, model {d.predicted}; {where}"
+            f"  {line}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured {d.measured}, "
+            f"model {d.predicted}; {where}"
         )
     if len(wrong) > LISTED:
         print(f"  ... and {len(wrong) - LISTED} more (--json lists all)")

@@ -40,12 +40,17 @@ def validation_figure(
 ) -> Figure:
     """For each obliquity of the shots, a column: exit speed and exit obliquity against
     impact speed, the model's curves (``simulation`` on ``points`` speeds over the
-    report's boundary speeds, for the report's sphere), its outcome bands as a strip, and
+    shots' speeds and a tenth of their span either side, for the report's sphere), its
+    outcome bands as a strip, and
     the shots as markers by measured outcome (red edge: the model disagrees). Shots are
     drawn where they measured a value; every shot is drawn on the strip."""
     shots = report.shots
     groups = np.unique(shots.impact_obliquity)
-    speeds = np.linspace(*report.speeds, points)
+    # The shots' speeds and a tenth of their span either side (within the speeds searched).
+    low, high = float(shots.impact_speed.min()), float(shots.impact_speed.max())
+    pad = 0.1 * (high - low) or 0.1 * high
+    span = (max(low - pad, report.speeds[0]), min(high + pad, report.speeds[1]))
+    speeds = np.linspace(*span, points)
     model = simulation.run_batch(SceneBatch.grid(report.sphere, report.plate, speeds, groups))
     nrows = math.ceil(groups.size / MAX_COLUMNS)
     ncols = math.ceil(groups.size / nrows)
@@ -73,7 +78,7 @@ def validation_figure(
                 strip_ax.plot(v, np.zeros(v.size), **style)
         speed_ax.set_title(f"{math.degrees(obliquity):.6g}°", fontsize=FONT, pad=3)
         strip_ax.set_yticks([])
-        strip_ax.set_xlim(*report.speeds)
+        strip_ax.set_xlim(*span)
         angle_ax.set_ylim(-8, 188)
         angle_ax.set_yticks([0, 45, 90, 135, 180])
         if column == 0:
