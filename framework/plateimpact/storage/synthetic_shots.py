@@ -75,8 +75,8 @@ def synthetic_oblique_shots(
       speed at most the recorded impact speed;
     * exit obliquity (perforation and ricochet): the model's + ``exit_obliquity_noise``
       [rad] × N(0, 1), kept in [0, π];
-    * a share ``go_no_go_fraction`` of the shots, drawn at random, record only whether
-      they perforated (outcome 0, no residual speed or exit obliquity).
+    * each shot, with probability ``go_no_go_fraction``, records only whether it
+      perforated (outcome 0, no residual speed or exit obliquity).
 
     With no noise the shots are the model's own results, to the last bit.
     """
