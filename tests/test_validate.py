@@ -26,6 +26,7 @@ PLATE = presets.plate("2024-T3/1.27")
 DEEPER = PLATE.with_constants(critical_penetration=1.3 * PLATE.critical_penetration)
 SIMULATION = pi.Simulation.from_names()
 OBLIQUITIES = np.array([0.0, 45.0, 60.0]) * deg
+IMPACT = "impact_speed_m_s,impact_obliquity_deg"
 SPEEDS = np.linspace(103.0, 403.0, 16)  # [m/s]; none within 0.1 m/s of a boundary (checked)
 
 
@@ -175,6 +176,22 @@ def test_a_shots_own_sphere_is_the_one_run_and_searched():
 # ------------------------------------------------------------------------- the command
 
 
+def test_the_figure_has_a_panel_per_obliquity_to_the_nearest_degree():
+    from plateimpact.experiment.figure import MAX_PANELS, validation_figure
+
+    text = f"{IMPACT},perforated\n200,44.6,0\n300,45.3,1\n250,60,0\n"
+    report = pi.validate(SIMULATION, SPHERE, PLATE, pi.Shots.from_csv_text(text))
+    figure = validation_figure(report, SIMULATION, points=20)
+    titles = [ax.get_title() for ax in figure.axes if ax.get_title()]
+    assert titles == ["45°", "60°"] and len(figure.axes) == 6  # three axes a panel
+    many = "".join(f"300,{k},1\n" for k in range(MAX_PANELS + 1))
+    with pytest.raises(pi.ShotDataError, match=f"shots at {MAX_PANELS + 1} obliquities"):
+        validation_figure(
+            attrs.evolve(report, shots=pi.Shots.from_csv_text(f"{IMPACT},perforated\n{many}")),
+            SIMULATION,
+        )
+
+
 @pytest.fixture(scope="module")
 def deeper_csv(tmp_path_factory):
     path = tmp_path_factory.mktemp("shots") / "deeper.csv"
@@ -212,9 +229,6 @@ def test_validate_text_and_figure(tmp_path, capsys):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-IMPACT = "impact_speed_m_s,impact_obliquity_deg"
-
-
 @pytest.mark.parametrize(
     ("text", "flags", "named"),
     [
@@ -224,14 +238,23 @@ IMPACT = "impact_speed_m_s,impact_obliquity_deg"
         (f"{IMPACT},perforated\n300,0,1\n", ["--pstar", "-1"], "--pstar"),
         (f"{IMPACT},perforated\n300,0,1\n", ["--png", "/no/such/x.png"], "--png"),
         (f"{IMPACT},perforated\n300,0,1\n", ["--radius", "0"], "--radius"),
+        (
+            f"{IMPACT},perforated\n" + "".join(f"300,{k},1\n" for k in range(17)),
+            ["--png", "x.png"],
+            "shots at 17 obliquities",
+        ),
     ],
 )  # fmt: skip
-def test_bad_shots_and_options_are_one_line_and_exit_2(text, flags, named, tmp_path, capsys):
+def test_bad_shots_and_options_are_one_line_and_exit_2(
+    text, flags, named, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
     path = tmp_path / "shots.csv"
     path.write_text(text)
     assert main(["validate", str(path), "--preset", "2024-T3/1.27", *flags]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("plateimpact: error: ") and named in err
+    assert [p.name for p in tmp_path.iterdir()] == ["shots.csv"]  # nothing written
 
 
 def test_the_shipped_oblique_examples_are_synthetic_and_agree_with_the_model_that_made_them():

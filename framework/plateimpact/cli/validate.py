@@ -55,6 +55,10 @@ def validate_command(args: argparse.Namespace) -> None:
     """Run ``plateimpact validate``."""
     check_directory(args.png, "--png", "figure")
     shots = Shots.from_csv(args.shots)
+    if args.png is not None:
+        from ..experiment.figure import check_panels  # noqa: PLC0415 (matplotlib)
+
+        check_panels(shots)
     choice = model_choice(args)
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)

@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..batch import SceneBatch
+from ..errors import ShotDataError
 from ..plotting import (
     FONT,
     MAX_COLUMNS,
@@ -21,6 +22,7 @@ from ..plotting import (
     regime_key,
 )
 from ..simulation import Simulation
+from ..storage.shots import Shots
 from .validation import MEASURED, ValidationReport, measured_classes
 
 #: Model-curve points per obliquity.
@@ -29,6 +31,24 @@ CURVE_POINTS = 300
 MARKERS = dict(zip(MEASURED, ("o", "s", "^", "P", "X"), strict=True))
 #: Edge colour of shots the model agrees with, and of those it does not.
 AGREES, DISAGREES = "k", "#d62728"
+#: Measured obliquities scatter about the nominal one: a panel holds the shots of one
+#: obliquity to the nearest degree, and the figure at most MAX_PANELS panels.
+MAX_PANELS = 16
+
+
+def panel_obliquities(shots: Shots) -> np.ndarray:
+    """The obliquity of each shot's panel [rad]: its own, to the nearest degree."""
+    return np.radians(np.round(np.degrees(shots.impact_obliquity)))
+
+
+def check_panels(shots: Shots) -> None:
+    """Refuse (ShotDataError) shots at more obliquities than a figure has panels."""
+    count = np.unique(panel_obliquities(shots)).size
+    if count > MAX_PANELS:
+        raise ShotDataError(
+            f"{shots.source}: shots at {count} obliquities (to the nearest degree); the "
+            f"figure draws at most {MAX_PANELS}"
+        )
 
 
 def validation_figure(
@@ -39,13 +59,17 @@ def validation_figure(
     points: int = CURVE_POINTS,
 ) -> Figure:
     """For each obliquity of the shots, a column: exit speed and exit obliquity against
-    impact speed, the model's curves (``simulation`` on ``points`` speeds over the
-    shots' speeds and a tenth of their span either side, for the report's sphere), its
-    outcome bands as a strip, and
-    the shots as markers by measured outcome (red edge: the model disagrees). Shots are
-    drawn where they measured a value; every shot is drawn on the strip."""
+    impact speed, the model's curves (``simulation`` on ``points`` speeds over the shots'
+    speeds and a tenth of their span either side, for the report's sphere), its outcome
+    bands as a strip, and the shots as markers by measured outcome (red edge: the model
+    disagrees). Shots are drawn where they measured a value; every shot is drawn on the
+    strip. A panel holds the shots of one obliquity to the nearest degree, and the
+    model's curves at that degree; ShotDataError for more than MAX_PANELS panels.
+    """
     shots = report.shots
-    groups = np.unique(shots.impact_obliquity)
+    check_panels(shots)
+    panels = panel_obliquities(shots)
+    groups = np.unique(panels)
     # The shots' speeds and a tenth of their span either side (within the speeds searched).
     low, high = float(shots.impact_speed.min()), float(shots.impact_speed.max())
     pad = 0.1 * (high - low) or 0.1 * high
@@ -66,7 +90,7 @@ def validation_figure(
         part = model.take(np.arange(n * points, (n + 1) * points))
         plot_exit_curves([speed_ax, angle_ax], speeds, part, color="0.2", lw=1.0)
         regimes |= plot_outcome_strip(strip_ax, speeds, [("model", part)])
-        mine = shots.impact_obliquity == obliquity
+        mine = panels == obliquity
         for name, marker in MARKERS.items():
             for agrees in (True, False):
                 index = mine & (classes == name) & (report.agrees == agrees)
