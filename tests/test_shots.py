@@ -224,3 +224,8 @@ def test_the_fits_of_a_and_b_refuse_per_shot_spheres_and_weights_rather_than_ign
         )
         with pytest.raises(pi.ShotDataError, match=r"^s.csv line 2: the fits of a and b take"):
             pi.newton_fit(shots, presets.plate("2024-T3/3.18"))
+
+
+def test_shots_built_in_python_need_one_entry_per_shot():
+    with pytest.raises(pi.ShotDataError, match=r"2 impact speeds but \{'outcome': 3\}"):
+        pi.Shots(np.ones(2), np.zeros(2), np.zeros(2), np.zeros(2), np.ones(3, int), ("a", "b"))

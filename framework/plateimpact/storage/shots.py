@@ -102,6 +102,8 @@ class Shots:
 
     @perforated.default
     def _perforated_from_outcome_or_speed(self) -> np.ndarray:
+        if np.shape(self.outcome) != np.shape(self.residual_speed):
+            return np.zeros(len(self), bool)  # __attrs_post_init__ names the mismatch
         known = self.outcome != 0
         return np.where(known, self.outcome == Outcome.PERFORATION, self.residual_speed > 0.0)
 
