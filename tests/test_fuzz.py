@@ -226,11 +226,14 @@ SHOT_COLUMNS = [
     "residual_speed_m_s",
     "exit_obliquity_deg",
     "outcome",
+    "perforated",
+    "weight",
+    "radius_mm",
     "note",
 ]
 CELLS = st.sampled_from(
     ["0", "500", "700", "900", "1200", "-3", "nan", "inf", "", "abc", "perforation", "ricochet",
-     "embedment", "1e400", "45", "0.0", "350", "2000", '"x,y"']
+     "embedment", "1e400", "45", "0.0", "350", "2000", '"x,y"', "1", "true"]
 )  # fmt: skip
 
 
@@ -245,6 +248,7 @@ def test_malformed_shot_files_give_one_line_errors(header, rows):
         path.write_text("\n".join(lines) + "\n")
         argv = ["calibrate", str(path), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
         assert_clean(*run_cli(argv))
+        assert_clean(*run_cli(["validate", str(path), "--preset", "2024-T3/3.18"]))
 
 
 PLATE_VALUES = st.one_of(

@@ -30,7 +30,7 @@ LAYERS = {
     "storage": {"storage"},
     "analysis": {
         "study", "comparison", "calibration", "plotting", "path_figures", "limits", "export",
-        "v50",
+        "experiment", "v50",
     },
     "cli": {"cli"},
 }  # fmt: skip

@@ -31,6 +31,7 @@ OUTPUT_FLAGS = [
      "--csv", ".csv"),
     ([*CALIBRATE], "--out", ".json"),
     ([*CALIBRATE], "--png", ".png"),
+    (["validate", str(SHOTS), "--preset", "2024-T3/3.18"], "--png", ".png"),
     (["plot", "ARCHIVE", "--run", "v"], "--out", ".png"),
     (["compare", "ARCHIVE", "v", "w"], "--png", ".svg"),
 ]  # fmt: skip

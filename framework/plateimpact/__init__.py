@@ -77,7 +77,8 @@ _EXPORTS: dict[str, str] = {
     "load_plate_file": "storage.plate_file",
     "save_plate_file": "storage.plate_file",
     "Shots": "storage.shots",
-    "synthetic_shots": "storage.shots",
+    "synthetic_shots": "storage.synthetic_shots",
+    "synthetic_oblique_shots": "storage.synthetic_shots",
     # analysis
     "Study": "study",
     "StudyResults": "study",
@@ -90,6 +91,8 @@ _EXPORTS: dict[str, str] = {
     "energy_balance_start": "calibration",
     "fit_dri": "calibration",
     "newton_fit": "calibration",
+    "validate": "experiment",
+    "ValidationReport": "experiment",
     # errors
     "PlateImpactError": "errors",
     "ParameterError": "errors",
@@ -106,7 +109,7 @@ _EXPORTS: dict[str, str] = {
     "PluginLoadWarning": "errors",
 }
 #: Submodules users reach as attributes (``pi.units.mm``).
-_SUBMODULES = ("batch", "calibration", "geometry", "limits", "presets", "units")
+_SUBMODULES = ("batch", "calibration", "experiment", "geometry", "limits", "presets", "units")
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
@@ -134,7 +137,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
-    from . import batch, calibration, geometry, presets, units
+    from . import batch, calibration, experiment, geometry, presets, units
     from .binding import BoundBatch
     from .bodies import Plate, Sphere
     from .calibration import (
@@ -166,6 +169,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         ShotDataError,
         UnknownNameError,
     )
+    from .experiment import ValidationReport, validate
     from .failure import FailureModel
     from .geometry import contact_geometry, contact_lost_margin, force_inclination
     from .hookspecs import hookimpl
@@ -203,7 +207,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .simulation import Simulation, run
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file
-    from .storage.shots import Shots, synthetic_shots
+    from .storage.shots import Shots
+    from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
     from .variant import Variant
 

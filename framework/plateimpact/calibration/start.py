@@ -90,8 +90,21 @@ def model_residual_speeds(
 
 
 def normal_shots(shots: Shots) -> Shots:
-    """The shots at normal incidence, with at least three perforations (ShotDataError)."""
+    """The shots at normal incidence that record a residual speed, with at least three
+    perforations (ShotDataError)."""
     normal = shots.normal_incidence()
+    # A DRI fit reads a residual speed > 0 as a perforation: go/no-go shots (no residual
+    # speed) and a rebound's exit speed tell it nothing.
+    residual = normal.residual_speed
+    normal = normal.take(np.isfinite(residual) & ((residual > 0.0) == normal.perforated))
+    # The fits of a and b run one sphere and weigh every shot alike: refuse, not ignore.
+    own = np.isfinite(normal.radius) | np.isfinite(normal.mass) | (normal.weight != 1.0)
+    if own.any():
+        raise ShotDataError(
+            f"{normal.labels[int(np.argmax(own))]}: the fits of a and b take one sphere "
+            "(--radius, --mass) and equal weights: remove radius_mm, mass_g and weight "
+            "from the normal-incidence shots"
+        )
     perforating = [label for label, p in zip(normal.labels, normal.perforated, strict=True) if p]
     if len(perforating) < MIN_PERFORATIONS:
         listed = f" ({', '.join(perforating)})" if perforating else ""

@@ -24,6 +24,7 @@ from . import (
     limits_commands,
     review_commands,
     scene_commands,
+    validate,
 )
 from .common import Parser, UsageError
 from .options import flag_of
@@ -55,6 +56,7 @@ def build_parser(registry: PluginRegistry | None = None) -> argparse.ArgumentPar
     try:
         scene_commands.add_parsers(sub, registry)
         calibrate.add_parsers(sub, registry)
+        validate.add_parsers(sub, registry)
         limits_commands.add_parsers(sub, registry)
     except argparse.ArgumentError as exc:  # a plug-in's flag is one of the command's own
         raise PluginError(_flag_taken(registry, str(exc).rsplit(": ", 1)[-1])) from None

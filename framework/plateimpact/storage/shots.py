@@ -1,14 +1,20 @@
-"""Shot data: impact and residual speeds measured in firings, from a CSV file or columns.
+"""Shot data: oblique firings, what each did and what was measured, from CSV or columns.
 
-A shot is one firing: impact speed [m/s], impact obliquity [deg] and residual speed [m/s]
-(the speed after perforating; 0 when the sphere did not perforate), optionally the exit
-obliquity [deg] and the outcome. The CSV header names the columns, in any order:
+A shot is one firing: impact speed [m/s] and obliquity [deg], and whether it perforated,
+told by any of its outcome (ricochet, embedment, perforation), a ``perforated`` 0/1
+(go/no-go data) or its residual speed [m/s]; optionally the exit obliquity [deg], the
+sphere's radius [mm] and mass [g] when they differ from shot to shot, a weight and a
+free-text source. The CSV header names the columns, in any order:
 
-    impact_speed_m_s,impact_obliquity_deg,residual_speed_m_s[,exit_obliquity_deg][,outcome]
+    impact_speed_m_s,impact_obliquity_deg[,outcome][,perforated][,residual_speed_m_s]
+    [,exit_obliquity_deg][,radius_mm][,mass_g][,weight][,source]
 
-Lines starting with ``#`` are comments; other columns are ignored. Every bad value raises
-:class:`~plateimpact.errors.ShotDataError` with one line naming the file, line, column and
-value (and how many more rows are bad).
+with at least one of ``outcome``, ``perforated`` and ``residual_speed_m_s``. Lines
+starting with ``#`` are comments; other columns are ignored; a UTF-8 byte order mark and
+CRLF line ends are read. Every bad value raises :class:`~plateimpact.errors.ShotDataError`
+with one line naming the file, line, column and value (and how many more rows are bad);
+what the outcome, ``perforated`` and residual speed say must agree (docs/calibration.md,
+"1. Shot data").
 """
 
 from __future__ import annotations
@@ -23,20 +29,28 @@ import attrs
 import numpy as np
 
 from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
-from ..errors import ShotDataError
+from ..bodies import MASS, RADIUS, Plate, Sphere, check_density
+from ..errors import ParameterError, ShotDataError
 from ..parameters import Parameter
 from ..results import RESULT_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import Simulation
-from ..units import deg
-
-RESIDUAL_SPEED = Parameter(
-    "residual_speed", "speed after perforating (0: the sphere did not perforate)", "m/s"
+from ..scene import IMPACT_OBLIQUITY
+from .shot_rows import (
+    COLUMNS,
+    PERFORATION_COLUMNS,
+    REQUIRED_COLUMNS,
+    RESIDUAL_SPEED,
+    ShotRow,
+    check_columns,
+    check_rows,
 )
-#: The CSV columns, named as the declarations of what they hold name them.
-REQUIRED_COLUMNS = (IMPACT_SPEED.key, IMPACT_OBLIQUITY.key, RESIDUAL_SPEED.key)
-OPTIONAL_COLUMNS = (RESULT_FIELDS["exit_obliquity"].key, "outcome")
+
+__all__ = ["COLUMNS", "PERFORATION_COLUMNS", "REQUIRED_COLUMNS", "RESIDUAL_SPEED", "Shots"]
+
+EXIT_OBLIQUITY = RESULT_FIELDS["exit_obliquity"]
+
+
+def _nan_like(instance: Shots) -> np.ndarray:
+    return np.full(len(instance), math.nan)
 
 
 @attrs.frozen(eq=False)
@@ -50,15 +64,27 @@ class Shots:
     impact_obliquity : numpy.ndarray
         θs [rad], in [0, π/2).
     residual_speed : numpy.ndarray
-        Vr [m/s], in [0, Vs]; 0 means the sphere did not perforate.
+        Speed when contact ended [m/s], in [0, Vs]: through the plate for a perforation,
+        the ricochet's exit speed, 0 for a shot that did not perforate; NaN where not
+        recorded.
     exit_obliquity : numpy.ndarray
         [rad], NaN where not recorded.
     outcome : numpy.ndarray
-        :class:`~plateimpact.Outcome` values, 0 where not recorded.
+        :class:`~plateimpact.Outcome` values, 0 where only go/no-go is known.
     labels : tuple of str
         Where each shot came from (``shots.csv line 7``), for error messages.
     source : str
         The file (or ``"shots"``), for error messages about the whole set.
+    perforated : numpy.ndarray
+        bool: whether each shot perforated. Default: the outcome where known, else a
+        residual speed > 0.
+    radius, mass : numpy.ndarray
+        The sphere of each shot, Rs [m] and m [kg]; NaN where the sphere of the command
+        (or of :meth:`scenes`) applies.
+    weight : numpy.ndarray
+        Weight of each shot in fits and scores, >= 0 (default 1).
+    notes : tuple of str
+        The free-text ``source`` column of each shot ("" where absent).
     """
 
     impact_speed: np.ndarray
@@ -68,14 +94,41 @@ class Shots:
     outcome: np.ndarray
     labels: tuple[str, ...]
     source: str = "shots"
+    perforated: np.ndarray = attrs.field(kw_only=True)
+    radius: np.ndarray = attrs.field(kw_only=True, default=attrs.Factory(_nan_like, True))
+    mass: np.ndarray = attrs.field(kw_only=True, default=attrs.Factory(_nan_like, True))
+    weight: np.ndarray = attrs.field(kw_only=True)
+    notes: tuple[str, ...] = attrs.field(kw_only=True)
+
+    @perforated.default
+    def _perforated_from_outcome_or_speed(self) -> np.ndarray:
+        if np.shape(self.outcome) != np.shape(self.residual_speed):
+            return np.zeros(len(self), bool)  # __attrs_post_init__ names the mismatch
+        known = self.outcome != 0
+        return np.where(known, self.outcome == Outcome.PERFORATION, self.residual_speed > 0.0)
+
+    @weight.default
+    def _unit_weights(self) -> np.ndarray:
+        return np.ones(len(self))
+
+    @notes.default
+    def _no_notes(self) -> tuple[str, ...]:
+        return ("",) * len(self)
+
+    def __attrs_post_init__(self) -> None:
+        sizes = {
+            name: len(getattr(self, name))
+            for name in ("impact_obliquity", "residual_speed", "exit_obliquity", "outcome")
+            + ("labels", "perforated", "radius", "mass", "weight", "notes")
+        }
+        wrong = {name: size for name, size in sizes.items() if size != len(self)}
+        if wrong:
+            raise ShotDataError(
+                f"{self.source}: {len(self)} impact speeds but {wrong} (one entry per shot)"
+            )
 
     def __len__(self) -> int:
-        return int(self.impact_speed.size)
-
-    @property
-    def perforated(self) -> np.ndarray:
-        """Whether each shot perforated (residual speed > 0)."""
-        return self.residual_speed > 0.0
+        return int(np.size(self.impact_speed))
 
     def take(self, index: np.ndarray) -> Shots:
         """The shots at ``index`` (a boolean mask or integer indices)."""
@@ -88,17 +141,58 @@ class Shots:
             self.outcome[kept],
             tuple(self.labels[i] for i in kept),
             self.source,
+            perforated=self.perforated[kept],
+            radius=self.radius[kept],
+            mass=self.mass[kept],
+            weight=self.weight[kept],
+            notes=tuple(self.notes[i] for i in kept),
         )
 
     def normal_incidence(self) -> Shots:
         """The shots fired at obliquity 0 (the ones the report calibrates a and b on)."""
         return self.take(self.impact_obliquity == 0.0)
 
+    def groups_by_obliquity(self) -> dict[float, Shots]:
+        """The shots of each impact obliquity [rad], in increasing obliquity."""
+        return {
+            float(obliquity): self.take(self.impact_obliquity == obliquity)
+            for obliquity in np.unique(self.impact_obliquity)
+        }
+
+    def spheres(self, sphere: Sphere) -> tuple[np.ndarray, np.ndarray]:
+        """(radius [m], mass [kg]) of each shot: its own where given, else ``sphere``'s;
+        :class:`ShotDataError` naming the shot whose sphere is not a solid's density."""
+        radius = np.where(np.isnan(self.radius), sphere.radius, self.radius)
+        mass = np.where(np.isnan(self.mass), sphere.mass, self.mass)
+        try:
+            check_density(radius, mass)
+        except ParameterError:
+            for i in range(len(self)):  # only to name the first bad shot
+                try:
+                    check_density(radius[i], mass[i])
+                except ParameterError as exc:
+                    raise ShotDataError(f"{self.labels[i]}: {exc}") from None
+        return radius, mass
+
+    def scenes(self, sphere: Sphere, plate: Plate) -> SceneBatch:
+        """One scene per shot: its impact, its own sphere where the file gives a radius
+        or mass (else ``sphere``'s), and ``plate``."""
+        radius, mass = self.spheres(sphere)
+        columns = {
+            "radius": radius,
+            "mass": mass,
+            "thickness": np.full(len(self), plate.thickness),
+            "impact_speed": self.impact_speed,
+            "impact_obliquity": self.impact_obliquity,
+        }
+        columns.update({name: np.full(len(self), value) for name, value in plate.constants})
+        return SceneBatch(columns)
+
     @classmethod
     def from_columns(
         cls, columns: Mapping[str, Sequence[object]], *, source: str = "shots"
     ) -> Shots:
-        """Shots from columns named as in the CSV header, in user units (m/s, deg).
+        """Shots from columns named as in the CSV header, in user units (m/s, deg, mm, g).
 
         Values may be numbers or strings; empty optional values mean "not recorded".
         Errors name the row by index: ``shots row 3, column ...``.
@@ -107,9 +201,10 @@ class Shots:
         if len(lengths) > 1:
             raise ShotDataError(f"{source}: columns differ in length: {sorted(lengths)}")
         count = lengths.pop() if lengths else 0
-        _check_columns(source, list(columns))
+        check_columns(source, list(columns))
         rows = [{name: columns[name][i] for name in columns} for i in range(count)]
-        return _parse_rows(rows, [f"{source} row {i}" for i in range(count)], source)
+        labels = [f"{source} row {i}" for i in range(count)]
+        return _of_rows(check_rows(rows, labels, source), labels, source)
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str]) -> Shots:
@@ -128,16 +223,17 @@ class Shots:
         """Shots from the text of a CSV file; ``source`` names it in error messages."""
         lines = [
             (number, line)
-            for number, line in enumerate(text.splitlines(), start=1)
+            for number, line in enumerate(text.removeprefix("\ufeff").splitlines(), start=1)
             if line.strip() and not line.lstrip().startswith("#")
         ]
         if not lines:
             raise ShotDataError(
-                f"{source}: empty file, expected a header naming {', '.join(REQUIRED_COLUMNS)}"
+                f"{source}: empty file, expected a header naming {', '.join(REQUIRED_COLUMNS)} "
+                f"and one of {', '.join(PERFORATION_COLUMNS)}"
             )
         records = list(csv.reader(line for _, line in lines))
         header = [name.strip() for name in records[0]]
-        _check_columns(f"{source} line {lines[0][0]}", header)
+        check_columns(f"{source} line {lines[0][0]}", header)
         rows, labels = [], []
         for (number, _), record in zip(lines[1:], records[1:], strict=True):
             if len(record) != len(header):
@@ -147,168 +243,71 @@ class Shots:
                 )
             rows.append(dict(zip(header, record, strict=True)))
             labels.append(f"{source} line {number}")
-        return _parse_rows(rows, labels, source)
+        return _of_rows(check_rows(rows, labels, source), labels, source)
 
     def to_csv_text(self, comments: Sequence[str] = ()) -> str:
-        """The shots as CSV in user units, all five columns, ``# comment`` lines first."""
+        """The shots as CSV in user units, ``# comment`` lines first: the columns that
+        carry something, each number written so that it reads back exactly."""
+        recorded = {
+            "outcome": bool((self.outcome != 0).any()),
+            # Needed only where neither the outcome nor a residual speed tells it.
+            "perforated": bool(((self.outcome == 0) & np.isnan(self.residual_speed)).any()),
+            RESIDUAL_SPEED.key: bool(np.isfinite(self.residual_speed).any()),
+            EXIT_OBLIQUITY.key: bool(np.isfinite(self.exit_obliquity).any()),
+            RADIUS.key: bool(np.isfinite(self.radius).any()),
+            MASS.key: bool(np.isfinite(self.mass).any()),
+            "weight": bool((self.weight != 1.0).any()),
+            "source": any(self.notes),
+        }
+        header = [c for c in COLUMNS if recorded.get(c, True)]
         buffer = io.StringIO()
         for comment in comments:
             buffer.write(f"# {comment}\n")
         writer = csv.writer(buffer, lineterminator="\n")
-        writer.writerow(REQUIRED_COLUMNS + OPTIONAL_COLUMNS)
+        writer.writerow(header)
         for i in range(len(self)):
-            exit_obliquity = self.exit_obliquity[i] / deg
-            writer.writerow(
-                [
-                    f"{self.impact_speed[i]:.6g}",
-                    f"{self.impact_obliquity[i] / deg:.6g}",
-                    f"{self.residual_speed[i]:.6g}",
-                    "" if math.isnan(exit_obliquity) else f"{exit_obliquity:.6g}",
-                    Outcome(int(self.outcome[i])).label if self.outcome[i] else "",
-                ]
-            )
+            cells = {
+                REQUIRED_COLUMNS[0]: _exact(self.impact_speed[i]),
+                REQUIRED_COLUMNS[1]: _exact(self.impact_obliquity[i], IMPACT_OBLIQUITY),
+                "outcome": Outcome(int(self.outcome[i])).label if self.outcome[i] else "",
+                "perforated": "1" if self.perforated[i] else "0",
+                RESIDUAL_SPEED.key: _exact(self.residual_speed[i]),
+                EXIT_OBLIQUITY.key: _exact(self.exit_obliquity[i], EXIT_OBLIQUITY),
+                RADIUS.key: _exact(self.radius[i], RADIUS),
+                MASS.key: _exact(self.mass[i], MASS),
+                "weight": _exact(self.weight[i]),
+                "source": self.notes[i],
+            }
+            writer.writerow([cells[c] for c in header])
         return buffer.getvalue()
 
 
-def _check_columns(where: str, names: Sequence[str]) -> None:
-    duplicated = sorted({n for n in names if names.count(n) > 1})
-    if duplicated:
-        raise ShotDataError(f"{where}: column {duplicated[0]} appears more than once")
-    missing = [c for c in REQUIRED_COLUMNS if c not in names]
-    if missing:
-        raise ShotDataError(
-            f"{where}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
-            f"(header has: {', '.join(names) or 'nothing'})"
-        )
+def _exact(value: float, declared: Parameter | None = None) -> str:
+    """``value`` [SI] in user units, as the shortest text that reads back to it; "" if NaN."""
+    value = float(value)
+    if math.isnan(value):
+        return ""
+    if declared is None:
+        return repr(value)
+    number = declared.user_number(value)
+    return repr(number if number is not None else value / declared.scale)
 
 
-def _number(value: object) -> float:
-    """A float from a number or a string; ValueError for anything else."""
-    if isinstance(value, bool):
-        raise ValueError
-    if isinstance(value, str):
-        return float(value.strip())
-    if isinstance(value, int | float | np.integer | np.floating):
-        return float(value)
-    raise ValueError
+def _of_rows(rows: Sequence[ShotRow], labels: Sequence[str], source: str) -> Shots:
+    def column(name: str) -> np.ndarray:
+        return np.array([getattr(row, name) for row in rows], dtype=float)
 
-
-def _is_blank(value: object) -> bool:
-    return value is None or (isinstance(value, str) and not value.strip())
-
-
-def _check_row(row: Mapping[str, object]) -> tuple[list[float | int], tuple[str, str] | None]:
-    """(values in user units, None) or (partial values, (column, problem)) for one row."""
-    values: list[float | int] = []
-    for column in REQUIRED_COLUMNS:
-        raw = row[column]
-        try:
-            x = _number(raw)
-        except (TypeError, ValueError):
-            return values, (column, f"not a number, got {raw!r}")
-        if not math.isfinite(x):
-            return values, (column, f"must be finite, got {raw!r}")
-        values.append(x)
-    speed, obliquity, residual = values
-    if not IMPACT_SPEED.range.contains(speed):
-        allowed = IMPACT_SPEED.describe_range()
-        return values, ("impact_speed_m_s", f"must be {allowed}, got {row['impact_speed_m_s']!r}")
-    if not 0.0 <= obliquity < 90.0:
-        return values, (
-            "impact_obliquity_deg",
-            f"must be in [0, 90) deg, got {row['impact_obliquity_deg']!r}",
-        )
-    if residual < 0.0:
-        return values, (
-            "residual_speed_m_s",
-            f"must be >= 0 m/s (0: no perforation), got {row['residual_speed_m_s']!r}",
-        )
-    if residual > speed:
-        return values, (
-            "residual_speed_m_s",
-            f"must not exceed the impact speed {speed:g} m/s, got {row['residual_speed_m_s']!r}",
-        )
-    exit_obliquity = math.nan
-    raw = row.get("exit_obliquity_deg")
-    if not _is_blank(raw):
-        try:
-            exit_obliquity = _number(raw)
-        except (TypeError, ValueError):
-            return values, ("exit_obliquity_deg", f"not a number, got {raw!r}")
-        if not 0.0 <= exit_obliquity <= 180.0:
-            return values, ("exit_obliquity_deg", f"must be in [0, 180] deg, got {raw!r}")
-    outcome = 0
-    raw = row.get("outcome")
-    if not _is_blank(raw):
-        names = {o.label: o for o in Outcome}
-        label = str(raw).strip().lower()
-        if label not in names:
-            return values, ("outcome", f"must be one of {', '.join(names)}, got {raw!r}")
-        outcome = int(names[label])
-        # The residual speed is the speed through the plate: only a perforation has one.
-        if (outcome == Outcome.PERFORATION) != (residual > 0.0):
-            return values, (
-                "outcome",
-                f"{label} contradicts residual speed {residual:g} m/s "
-                "(only a perforation has a residual speed > 0)",
-            )
-    return [speed, obliquity, residual, exit_obliquity, outcome], None
-
-
-def _parse_rows(rows: Sequence[Mapping[str, object]], labels: list[str], source: str) -> Shots:
-    if not rows:
-        raise ShotDataError(f"{source}: no shots after the header")
-    parsed, problems = [], []
-    for label, row in zip(labels, rows, strict=True):
-        values, problem = _check_row(row)
-        if problem is None:
-            parsed.append(values)
-        else:
-            problems.append(f"{label}, column {problem[0]}: {problem[1]}")
-    if problems:
-        more = f" (and {len(problems) - 1} more bad rows)" if len(problems) > 1 else ""
-        raise ShotDataError(problems[0] + more)
-    table = np.array(parsed, dtype=float).T
     return Shots(
-        impact_speed=table[0],
-        impact_obliquity=table[1] * deg,
-        residual_speed=table[2],
-        exit_obliquity=table[3] * deg,
-        outcome=table[4].astype(int),
+        impact_speed=column("impact_speed"),
+        impact_obliquity=column("impact_obliquity") * IMPACT_OBLIQUITY.scale,
+        residual_speed=column("residual_speed"),
+        exit_obliquity=column("exit_obliquity") * EXIT_OBLIQUITY.scale,
+        outcome=column("outcome").astype(int),
         labels=tuple(labels),
         source=source,
-    )
-
-
-def synthetic_shots(
-    plate: Plate,
-    sphere: Sphere,
-    impact_speeds: Sequence[float] | np.ndarray,
-    *,
-    noise: float = 0.0,
-    seed: int | None = None,
-    simulation: Simulation | None = None,
-) -> Shots:
-    """Shots at normal incidence made by the model itself, with optional noise.
-
-    The residual speeds are the model's for ``plate`` and ``sphere`` at
-    ``impact_speeds`` [m/s] (one batch), each multiplied by ``1 + noise * N(0, 1)``
-    (``noise`` is the relative standard deviation, e.g. 0.02; a perforation stays a
-    perforation: the factor is kept above 0.1). For testing a calibration against known
-    constants, never as a substitute for firings.
-    """
-    speeds = np.asarray(impact_speeds, dtype=float).reshape(-1)
-    simulation = simulation or Simulation.from_names()
-    result = simulation.run_batch(SceneBatch.grid(sphere, plate, speeds, np.zeros(1)))
-    factor = 1.0 + noise * np.random.default_rng(seed).standard_normal(speeds.size)
-    residual = result.exit_speed * np.maximum(factor, 0.1)
-    perforated = result.outcome == Outcome.PERFORATION
-    return Shots(
-        impact_speed=speeds,
-        impact_obliquity=np.zeros(speeds.size),
-        residual_speed=np.where(perforated, np.minimum(residual, speeds), 0.0),
-        exit_obliquity=np.where(perforated, result.exit_obliquity, np.nan),
-        outcome=result.outcome.astype(int),
-        labels=tuple(f"synthetic shot {i}" for i in range(speeds.size)),
-        source="synthetic shots",
+        perforated=column("perforated").astype(bool),
+        radius=column("radius") * RADIUS.scale,
+        mass=column("mass") * MASS.scale,
+        weight=column("weight"),
+        notes=tuple(row.note for row in rows),
     )

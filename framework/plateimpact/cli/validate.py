@@ -1,0 +1,127 @@
+"""``plateimpact validate``: the model against measured shots (docs/experiment.md)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+from ..experiment import MEASURED, PREDICTED, ValidationReport, validate
+from ..progress import reporting_scenes
+from ..registry import PluginRegistry
+from ..storage.shots import Shots
+from .common import check_directory, save_figure_atomically
+from .options import add_body_options, add_model_options, bodies, model_choice
+
+#: Disagreeing shots listed in the text output (--json lists all).
+LISTED = 10
+
+
+def add_parsers(sub: Any, registry: PluginRegistry) -> None:
+    """Add the ``validate`` sub-command to the sub-parsers ``sub``."""
+    p = sub.add_parser(
+        "validate",
+        help="run the model on measured shots: outcome agreement, residual-speed and "
+        "exit-obliquity errors, the shots that disagree",
+        description="Run the model on every shot of SHOTS.csv and compare: the confusion "
+        "matrix of outcomes (measured -> predicted; go/no-go shots perforated or not), the "
+        "weighted agreement, the residual-speed error (RMS and bias, model minus measured) "
+        "and exit-obliquity error (RMS) where shot and model both leave the plate the same "
+        "way, and each disagreeing shot with its distance to the nearest boundary of the "
+        "model along impact speed.",
+    )
+    p.add_argument(
+        "shots",
+        metavar="SHOTS.csv",
+        help="columns impact_speed_m_s,impact_obliquity_deg and any of outcome, perforated, "
+        "residual_speed_m_s, exit_obliquity_deg, radius_mm, mass_g, weight, source",
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--png",
+        metavar="FILE",
+        help="draw each obliquity's exit speed and obliquity, the model's curves and "
+        "bands, and the shots",
+    )
+    add_body_options(p, registry)
+    add_model_options(p, registry)
+    p.set_defaults(command_function=validate_command)
+
+
+def validate_command(args: argparse.Namespace) -> None:
+    """Run ``plateimpact validate``."""
+    check_directory(args.png, "--png", "figure")
+    shots = Shots.from_csv(args.shots)
+    if args.png is not None:
+        from ..experiment.figure import check_panels  # noqa: PLC0415 (matplotlib)
+
+        check_panels(shots)
+    choice = model_choice(args)
+    simulation = choice.simulation()
+    sphere, plate, label = bodies(args, choice, simulation.model)
+    with reporting_scenes("validate"):  # a count of scenes on a terminal after 2 s
+        report = validate(simulation, sphere, plate, shots)
+        if args.png is not None:
+            from ..experiment.figure import validation_figure  # noqa: PLC0415 (matplotlib)
+
+            figure = validation_figure(report, simulation, title=label)
+    if args.png is not None:
+        save_figure_atomically(figure, args.png)
+    if args.json:
+        print(json.dumps({"shots_file": args.shots, "plate_label": label, **report.to_json()}))
+    else:
+        _print_text(args, label, report)
+
+
+def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) -> None:
+    shots = report.shots
+    model = report.model
+    go_no_go = int((shots.outcome == 0).sum())
+    angles = ", ".join(f"{math.degrees(o):.6g}" for o in shots.groups_by_obliquity())
+    print(
+        f"{label}: {len(shots)} shots from {args.shots}"
+        + (f" ({go_no_go} go/no-go)" if go_no_go else "")
+        + f" at {angles} deg; model {model['resistance']} + {model['failure']} "
+        f"({model['integrator']})"
+    )
+    print(f"outcome agreement {100 * report.agreement:.1f}% (weighted)")
+    width = max(len(name) for name in MEASURED) + 2
+    print(f"  {'measured -> model':{width}s}" + "".join(f"{p:>13s}" for p in PREDICTED))
+    for name in MEASURED:
+        counts = report.confusion[name]
+        if any(counts.values()):
+            print(f"  {name:{width}s}" + "".join(f"{counts[p]:13d}" for p in PREDICTED))
+    pairs = int(np.isfinite(report.residual_speed_error).sum())
+    if pairs:
+        print(
+            f"residual speed, model - measured: rms {report.residual_speed_rms:.3g} m/s, "
+            f"bias {report.residual_speed_bias:+.3g} m/s over {pairs} shots"
+        )
+    else:
+        print("residual speed: no shot where shot and model leave the plate the same way")
+    pairs = int(np.isfinite(report.exit_obliquity_error).sum())
+    if pairs:
+        rms = math.degrees(report.exit_obliquity_rms)
+        print(f"exit obliquity, model - measured: rms {rms:.3g} deg over {pairs} shots")
+    wrong = report.disagreements
+    if wrong:
+        print(f"{len(wrong)} shots disagree (distance to the nearest boundary of the model):")
+    for d in wrong[:LISTED]:
+        where = (
+            f"{d.distance:.3g} m/s from the boundary at {d.boundary:.2f} m/s"
+            if d.distance is not None
+            else f"no boundary in {report.speeds[0]:g}-{report.speeds[1]:g} m/s"
+        )
+        line = d.label.removeprefix(f"{args.shots} ")  # the file is named above
+        angle = math.degrees(d.impact_obliquity)
+        print(
+            f"  {line}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured {d.measured}, "
+            f"model {d.predicted}; {where}"
+        )
+    if len(wrong) > LISTED:
+        print(f"  ... and {len(wrong) - LISTED} more (--json lists all)")
+    if args.png is not None:
+        print(f"figure: {args.png}")
