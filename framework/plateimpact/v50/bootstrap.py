@@ -15,8 +15,9 @@ the data are thin):
   curve P = the share perforated, σ = ∞ and the p-quantile at −∞ if that share exceeds
   p, +∞ if it falls short (undefined, and left out, if equal).
 
-An interval end at ±∞ is reported as None (unbounded); a quantity left out of more
-resamples than an interval's tail holds gets no interval.
+An interval end at ±∞, or a speed's end at or below 0 m/s, is reported as None
+(unbounded); a quantity left out of more resamples than an interval's tail holds gets no
+interval.
 """
 
 from __future__ import annotations
@@ -107,8 +108,9 @@ def bootstrap_intervals(
         if known.size < (1.0 - tail) * resamples:
             continue  # undefined in more resamples than the tail holds
         low, high = np.quantile(known, [tail, 1.0 - tail], method="inverted_cdf")
+        floor = 0.0 if name in levels else -math.inf  # a speed below 0 m/s: unbounded
         intervals[name] = (
-            float(low) if math.isfinite(low) else None,
-            float(high) if math.isfinite(high) else None,
+            float(low) if math.isfinite(low) and low > floor else None,
+            float(high) if math.isfinite(high) and high > floor else None,
         )
     return BootstrapIntervals(intervals, kinds["separated"], kinds["flat"])

@@ -45,9 +45,10 @@ class V50Fit:
     interval of ``bootstrap_resamples`` resamples (None if 0), of which
     ``bootstrap_separated`` had outcomes that did not overlap and ``bootstrap_flat`` no
     rise of perforation with speed (plateimpact.v50.bootstrap). An interval end is
-    None where the data do not bound it. ``mixed_zone_m_s`` is [the slowest perforation,
-    the fastest non-perforation]. ``fit_v50`` raises rather than return a fit that did
-    not converge, so ``converged`` is True on every fit it returns.
+    None where the data do not bound it (for a speed: above 0 m/s). ``mixed_zone_m_s`` is
+    [the slowest perforation, the fastest non-perforation]. ``fit_v50`` raises rather
+    than return a fit that did not converge, so ``converged`` is True on every fit it
+    returns.
     """
 
     method: str

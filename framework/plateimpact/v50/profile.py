@@ -9,7 +9,7 @@ in a; both one-dimensional problems are convex. Each end is bracketed by steppin
 from the estimate, doubling the step, then found by Brent's method. Unlike a Wald
 interval (estimate ± 1.96 standard errors) the ends need not be symmetric, which they
 are not for σ or for few shots; and an end beyond the reach searched is reported as None
-(the data do not bound it).
+(the data do not bound it), as is a speed's end below 0 m/s.
 """
 
 from __future__ import annotations
@@ -24,7 +24,8 @@ from .likelihood import Estimate, GoNoGo, Link
 #: An interval [low, high]; None for an end the data do not bound.
 Interval = tuple[float | None, float | None]
 #: How far an end is searched for: a speed within this many standard deviations of the
-#: shot speeds from the estimate; a scale within this factor of the estimate's.
+#: shot speeds from the estimate, and above 0 m/s; a scale within this factor of the
+#: estimate's.
 SPEED_REACH, SCALE_REACH = 100.0, 1e3
 #: The nuisance b = 1/s is searched in [0, this × the estimate's b].
 SLOPE_REACH = 1e3
@@ -74,21 +75,26 @@ def scale_profile(shots: GoNoGo, link: Link, best: Estimate) -> Callable[[float]
 
 
 def interval_end(
-    deviance: Callable[[float], float], start: float, step: float, reach: float
+    deviance: Callable[[float], float], start: float, step: float, limit: float
 ) -> float | None:
     """Where ``deviance`` (< 0 at ``start``) crosses 0, stepping out from ``start`` by
-    ``step`` (signed), doubling; None if it stays below 0 within ``reach`` of ``start``."""
+    ``step`` (signed), doubling, as far as ``limit``; None if it does not before."""
+    direction = math.copysign(1.0, step)
+    if (limit - start) * direction <= 0.0:
+        return None
     inner, outer = start, start + step
-    while deviance(outer) < 0.0:
-        if abs(outer - start) > reach:
-            return None
+    while (outer - limit) * direction < 0.0 and deviance(outer) < 0.0:
         inner, outer = outer, start + 2.0 * (outer - start)
+    if (outer - limit) * direction >= 0.0:
+        outer = limit
+        if deviance(outer) < 0.0:
+            return None
     return float(optimize.brentq(deviance, inner, outer, xtol=END_TOLERANCE))
 
 
 def _interval(
-    profile: Callable[[float], float], best: Estimate, centre: float, step: float, reach: float,
-    confidence: float,
+    profile: Callable[[float], float], best: Estimate, centre: float, step: float,
+    limits: tuple[float, float], confidence: float,
 ) -> tuple[float | None, float | None]:  # fmt: skip
     level = best.negative_log_likelihood + 0.5 * threshold(confidence)
 
@@ -96,8 +102,8 @@ def _interval(
         return 2.0 * (profile(theta) - level)
 
     return (
-        interval_end(deviance, centre, -step, reach),
-        interval_end(deviance, centre, step, reach),
+        interval_end(deviance, centre, -step, limits[0]),
+        interval_end(deviance, centre, step, limits[1]),
     )
 
 
@@ -109,17 +115,20 @@ def profile_intervals(
     found: dict[str, Interval] = {}
     for name, p in levels.items():
         centre = best.location + best.scale * link.quantile(p)
+        # no further than SPEED_REACH either side, and no speed below 0 m/s
+        limits = (max(centre - SPEED_REACH, -shots.centre / shots.spread), centre + SPEED_REACH)
         low, high = _interval(
-            quantile_profile(shots, link, p, best), best, centre, best.scale, SPEED_REACH,
-            confidence,
-        )  # fmt: skip
+            quantile_profile(shots, link, p, best), best, centre, best.scale, limits, confidence
+        )
         found[name] = (
             None if low is None else shots.speed(low),
             None if high is None else shots.speed(high),
         )
+    log_scale = math.log(best.scale)
+    reach = math.log(SCALE_REACH)
     log_low, log_high = _interval(
-        scale_profile(shots, link, best), best, math.log(best.scale), 0.25,
-        math.log(SCALE_REACH), confidence,
+        scale_profile(shots, link, best), best, log_scale, 0.25,
+        (log_scale - reach, log_scale + reach), confidence,
     )  # fmt: skip
     per_x = shots.spread * link.sigma_per_scale
     found["sigma"] = (
@@ -129,10 +138,4 @@ def profile_intervals(
     return found
 
 
-def profile_deviance(shots: GoNoGo, link: Link, best: Estimate, p: float, speed: float) -> float:
-    """The profile deviance of the p-quantile at ``speed`` [m/s] (0 at the estimate)."""
-    t = (speed - shots.centre) / shots.spread
-    return 2.0 * (quantile_profile(shots, link, p, best)(t) - best.negative_log_likelihood)
-
-
-__all__ = ["Interval", "profile_deviance", "profile_intervals", "threshold"]
+__all__ = ["Interval", "profile_intervals", "threshold"]
