@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -88,10 +89,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     )
     add_body_options(p, registry)
     add_model_options(p, registry)
-    own = {"shots", "method", "by_obliquity", "json", "png", "command_function", "debug"}
-    own |= set(FIT_OPTIONS) | set(MIL_STD_OPTIONS)
-    # The plate and model options: any of them asks for the model's ballistic limit.
-    model_options = sorted({a.dest for a in p._actions} - own - {"help"})
+    # The plate and model options, by destination: any of them asks for the model's
+    # ballistic limit (and then for a plate), none is ignored.
+    probe = argparse.ArgumentParser(add_help=False)
+    add_body_options(probe, registry)
+    add_model_options(probe, registry)
+    model_options = sorted(vars(probe.parse_args([])))
     p.set_defaults(command_function=v50_command, model_options=model_options)
 
 
@@ -104,7 +107,7 @@ def _number(text: str, flag: str, kind: type = float) -> Any:
     return value
 
 
-def _estimator(args: argparse.Namespace) -> Any:
+def _estimator(args: argparse.Namespace) -> Callable[..., Estimate]:
     """A function of (speed, perforated, weight, label) for --method and its options."""
     flags = typed(args)
     flags.update({**FIT_OPTIONS, **MIL_STD_OPTIONS})  # ParameterError names the flag
