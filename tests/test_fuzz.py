@@ -249,6 +249,7 @@ def test_malformed_shot_files_give_one_line_errors(header, rows):
         argv = ["calibrate", str(path), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
         assert_clean(*run_cli(argv))
         assert_clean(*run_cli(["validate", str(path), "--preset", "2024-T3/3.18"]))
+        assert_clean(*run_cli(["v50", str(path), "--by-obliquity", "--bootstrap", "20"]))
 
 
 PLATE_VALUES = st.one_of(

@@ -30,7 +30,7 @@ LAYERS = {
     "storage": {"storage"},
     "analysis": {
         "study", "comparison", "calibration", "plotting", "path_figures", "limits", "export",
-        "experiment",
+        "experiment", "v50",
     },
     "cli": {"cli"},
 }  # fmt: skip

@@ -20,6 +20,7 @@ from plateimpact.storage import append as appending
 from plateimpact.storage import output
 
 SHOTS = Path(__file__).resolve().parents[1] / "studies" / "data" / "shots_2024T3_3.18mm.csv"
+GONOGO = SHOTS.with_name("gonogo_SAE1010_1.47mm.csv")
 SCENE = ["--preset", "2024-T3/3.18", "--speed", "500", "--obliquity", "30"]
 CALIBRATE = ["calibrate", str(SHOTS), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
 # (command line before the flag, the flag, the file's suffix). ARCHIVE: a small archive.
@@ -32,6 +33,7 @@ OUTPUT_FLAGS = [
     ([*CALIBRATE], "--out", ".json"),
     ([*CALIBRATE], "--png", ".png"),
     (["validate", str(SHOTS), "--preset", "2024-T3/3.18"], "--png", ".png"),
+    (["v50", str(GONOGO), "--by-obliquity", "--bootstrap", "0"], "--png", ".png"),
     (["plot", "ARCHIVE", "--run", "v"], "--out", ".png"),
     (["compare", "ARCHIVE", "v", "w"], "--png", ".svg"),
 ]  # fmt: skip

@@ -93,6 +93,10 @@ _EXPORTS: dict[str, str] = {
     "newton_fit": "calibration",
     "validate": "experiment",
     "ValidationReport": "experiment",
+    "V50Fit": "v50",
+    "MilStd662F": "v50",
+    "fit_v50": "v50",
+    "mil_std_662f": "v50",
     # errors
     "PlateImpactError": "errors",
     "ParameterError": "errors",
@@ -103,13 +107,16 @@ _EXPORTS: dict[str, str] = {
     "PlateFileError": "errors",
     "CalibrationError": "errors",
     "ConvergenceError": "errors",
+    "V50Error": "errors",
     "PluginError": "errors",
     "PlateImpactWarning": "errors",
     "ArchiveWaitWarning": "errors",
     "PluginLoadWarning": "errors",
 }
 #: Submodules users reach as attributes (``pi.units.mm``).
-_SUBMODULES = ("batch", "calibration", "experiment", "geometry", "limits", "presets", "units")
+_SUBMODULES = (
+    "batch", "calibration", "experiment", "geometry", "limits", "presets", "units", "v50",
+)  # fmt: skip
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
@@ -137,7 +144,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
-    from . import batch, calibration, experiment, geometry, presets, units
+    from . import batch, calibration, experiment, geometry, presets, units, v50
     from .binding import BoundBatch
     from .bodies import Plate, Sphere
     from .calibration import (
@@ -168,6 +175,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         PluginLoadWarning,
         ShotDataError,
         UnknownNameError,
+        V50Error,
     )
     from .experiment import ValidationReport, validate
     from .failure import FailureModel
@@ -210,6 +218,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .storage.shots import Shots
     from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
+    from .v50 import MilStd662F, V50Fit, fit_v50, mil_std_662f
     from .variant import Variant
 
     __version__: str

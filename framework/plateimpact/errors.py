@@ -62,6 +62,12 @@ class ConvergenceError(CalibrationError):
     """The report's Newton iteration (eqs 44–49) did not converge within its iterations."""
 
 
+class V50Error(PlateImpactError, ValueError):
+    """No V50 can be estimated from go/no-go shots: too few shots, only one outcome,
+    perforations and non-perforations that do not overlap in speed (the likelihood has
+    no maximum), or the conditions of MIL-STD-662F not met. The message says what to do."""
+
+
 class PluginError(PlateImpactError):
     """A plug-in is malformed or two plug-ins conflict: an undeclared or missing prepared
     column, two declarations of one plate constant that disagree, a class that cannot be

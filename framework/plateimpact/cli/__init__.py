@@ -24,6 +24,7 @@ from . import (
     limits_commands,
     review_commands,
     scene_commands,
+    v50_command,
     validate,
 )
 from .common import Parser, UsageError
@@ -58,6 +59,7 @@ def build_parser(registry: PluginRegistry | None = None) -> argparse.ArgumentPar
         calibrate.add_parsers(sub, registry)
         validate.add_parsers(sub, registry)
         limits_commands.add_parsers(sub, registry)
+        v50_command.add_parsers(sub, registry)
     except argparse.ArgumentError as exc:  # a plug-in's flag is one of the command's own
         raise PluginError(_flag_taken(registry, str(exc).rsplit(": ", 1)[-1])) from None
     archive_commands.add_parsers(sub)

@@ -1,0 +1,217 @@
+"""The likelihood of go/no-go shots under P(perforation) = F((v − V50)/s), and its maximum.
+
+Each shot i, at impact speed v_i [m/s] with weight w_i (a frequency: w_i identical
+shots), perforated (y_i = 1) or not (y_i = 0). F is symmetric (1 − F(z) = F(−z)), so with
+u_i = (2 y_i − 1) z_i the negative log-likelihood is
+
+    −log L = −Σ w_i log F(u_i),   z_i = (v_i − V50)/s
+
+with F = Φ (probit; s is the normal's standard deviation σ) or the logistic CDF
+1/(1 + e^−z) (logit; s is its scale, its standard deviation σ = s π/√3). In the linear
+form z = β0 + β1 x of a binomial GLM, x = (v − c)/d the speeds centred and scaled, −log L
+is convex in (β0, β1) (F is log-concave), so its maximum is unique where it exists;
+scipy's trust-region solver finds it from the exact gradient and Hessian written below.
+It exists if and only if the speeds of the two outcomes overlap (the highest
+non-perforation is faster than the lowest perforation): otherwise s → 0 and no finite
+maximum is reached (quasi-complete separation), which :func:`check_shots` refuses.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import attrs
+import numpy as np
+from scipy import optimize, special
+
+from ..errors import ParameterError, V50Error
+
+#: The fits, by name.
+PROBIT, LOGIT = "probit", "logit"
+METHODS = (PROBIT, LOGIT)
+#: Fewest shots (of positive weight) a fit takes: two parameters and something left over.
+MIN_SHOTS = 4
+#: The maximum is where |d(−log L)/dβ| <= this × the total weight (the shots), within
+#: this many trust-region steps (a convex problem takes fewer than 20).
+GRADIENT_TOLERANCE, MAX_ITERATIONS = 1e-8, 200
+
+
+@attrs.frozen
+class Link:
+    """F of the model, with what the fit needs of it (all vectorised over z)."""
+
+    name: str
+    log_cdf: Callable[[np.ndarray], np.ndarray]  # log F(z)
+    hazard: Callable[[np.ndarray], np.ndarray]  # λ(z) = F'(z)/F(z) = d log F/dz
+    curvature: Callable[[np.ndarray], np.ndarray]  # −d²log F/dz² = −λ'(z) > 0
+    quantile: Callable[[float], float]  # F⁻¹(p)
+    sigma_per_scale: float  # the standard deviation of F at s = 1
+
+
+def _probit_hazard(z: np.ndarray) -> np.ndarray:
+    # φ(z)/Φ(z) from logarithms: exact in both tails, where φ and Φ underflow
+    return np.exp(-0.5 * z * z - 0.5 * math.log(2 * math.pi) - special.log_ndtr(z))
+
+
+def _probit_curvature(z: np.ndarray) -> np.ndarray:
+    hazard = _probit_hazard(z)
+    return hazard * (z + hazard)
+
+
+LINKS = {
+    PROBIT: Link(PROBIT, special.log_ndtr, _probit_hazard, _probit_curvature, special.ndtri, 1.0),
+    LOGIT: Link(
+        LOGIT,
+        lambda z: -np.logaddexp(0.0, -z),
+        lambda z: special.expit(-z),
+        lambda z: special.expit(z) * special.expit(-z),
+        special.logit,
+        math.pi / math.sqrt(3.0),
+    ),
+}
+
+
+def link_of(method: str) -> Link:
+    if method not in LINKS:
+        raise ParameterError(
+            "method", f"method must be one of {', '.join(METHODS)}, got {method!r}"
+        )
+    return LINKS[method]
+
+
+@attrs.frozen(eq=False)
+class GoNoGo:
+    """Go/no-go shots ready for the likelihood: the speeds centred and scaled,
+    x = (v − centre)/spread, the outcome as a sign (+1 perforated, −1 not), weights > 0."""
+
+    x: np.ndarray
+    sign: np.ndarray
+    weight: np.ndarray
+    centre: float  # [m/s]
+    spread: float  # [m/s]
+
+    def speed(self, x: float) -> float:
+        """A position in x back in m/s."""
+        return self.centre + self.spread * x
+
+    def negative_log_likelihood(self, eta: np.ndarray, link: Link) -> float:
+        """−log L for the linear predictor η_i = z_i (one value per shot)."""
+        return float(-np.sum(self.weight * link.log_cdf(self.sign * eta)))
+
+    def eta_derivatives(self, eta: np.ndarray, link: Link) -> tuple[np.ndarray, np.ndarray]:
+        """d(−log L)/dη_i and d²(−log L)/dη_i² per shot."""
+        u = self.sign * eta
+        return -self.weight * self.sign * link.hazard(u), self.weight * link.curvature(u)
+
+
+@attrs.frozen
+class Estimate:
+    """The maximum of the likelihood: z = intercept + slope x, x in the units of GoNoGo;
+    for slope > 0, z = (x − location)/scale."""
+
+    intercept: float
+    slope: float
+    negative_log_likelihood: float
+    iterations: int
+
+    @property
+    def location(self) -> float:
+        return -self.intercept / self.slope
+
+    @property
+    def scale(self) -> float:
+        return 1.0 / self.slope
+
+
+def check_arrays(
+    speed: object, perforated: object, weight: object | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The shots as float speeds [m/s] (finite, > 0), bools and weights (finite, >= 0)."""
+    v = np.asarray(speed, dtype=float).reshape(-1)
+    y = np.asarray(perforated).reshape(-1)
+    w = np.ones(v.size) if weight is None else np.asarray(weight, dtype=float).reshape(-1)
+    if y.size != v.size or w.size != v.size:
+        raise ParameterError(
+            "perforated",
+            f"impact_speed, perforated and weight must have one value per shot, got "
+            f"{v.size}, {y.size} and {w.size}",
+        )
+    if not np.all(np.isfinite(v) & (v > 0)):
+        raise ParameterError("impact_speed", "impact speeds must be finite and > 0 m/s")
+    if not np.isin(y, (0, 1)).all():
+        raise ParameterError("perforated", "perforated must be true/false (1/0) per shot")
+    if not np.all(np.isfinite(w) & (w >= 0)):
+        raise ParameterError("weight", "weights must be finite and >= 0")
+    return v, y.astype(bool), w
+
+
+def check_shots(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray, label: str) -> None:
+    """Refuse shots no fit can take: too few, one outcome, or no overlap of the outcomes."""
+    used = weight > 0
+    count, go = int(used.sum()), int((used & perforated).sum())
+    if count < MIN_SHOTS or go == 0 or go == count:
+        raise V50Error(
+            f"{label}: too few shots for a V50 fit: {count} shots, {go} perforations and "
+            f"{count - go} non-perforations; a fit needs at least {MIN_SHOTS} shots with "
+            "both outcomes"
+        )
+    highest_no_go = float(speed[used & ~perforated].max())
+    lowest_go = float(speed[used & perforated].min())
+    if highest_no_go <= lowest_go:
+        raise V50Error(
+            f"{label}: no zone of mixed results: every perforation (the slowest at "
+            f"{lowest_go:.6g} m/s) is at least as fast as every non-perforation (the fastest "
+            f"at {highest_no_go:.6g} m/s), so the likelihood has no maximum (sigma -> 0); fire "
+            f"more shots between {highest_no_go:.6g} and {lowest_go:.6g} m/s, or use the "
+            "MIL-STD-662F estimate (--method mil-std-662f)"
+        )
+
+
+def prepared(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray) -> GoNoGo:
+    """The shots of positive weight, centred and scaled by their weighted mean and
+    standard deviation (so that the fit's numbers are of order one)."""
+    used = weight > 0
+    v, w = speed[used], weight[used]
+    centre = float(np.average(v, weights=w))
+    spread = float(np.sqrt(np.average((v - centre) ** 2, weights=w)))
+    sign = np.where(perforated[used], 1.0, -1.0)
+    return GoNoGo((v - centre) / spread, sign, w, centre, spread)
+
+
+def maximum(shots: GoNoGo, link: Link, label: str) -> Estimate:
+    """The maximum of the likelihood, by scipy's trust-region solver on the convex
+    −log L(β0, β1), z = β0 + β1 x; V50Error if it does not converge."""
+    design = np.column_stack([np.ones_like(shots.x), shots.x])
+
+    def value(beta: np.ndarray) -> float:
+        return shots.negative_log_likelihood(design @ beta, link)
+
+    def gradient(beta: np.ndarray) -> np.ndarray:
+        return design.T @ shots.eta_derivatives(design @ beta, link)[0]
+
+    def hessian(beta: np.ndarray) -> np.ndarray:
+        curvature = shots.eta_derivatives(design @ beta, link)[1]
+        return (design.T * curvature) @ design
+
+    tolerance = GRADIENT_TOLERANCE * float(shots.weight.sum())
+    found = optimize.minimize(
+        value, np.array([0.0, 1.0]), jac=gradient, hess=hessian, method="trust-exact",
+        options={"gtol": tolerance, "maxiter": MAX_ITERATIONS},
+    )  # fmt: skip
+    # Converged is a gradient at zero to rounding, whatever the solver's status says (it
+    # may stop one step late, unable to improve on a value already exact to rounding).
+    if not (np.all(np.isfinite(found.x)) and np.abs(gradient(found.x)).max() <= tolerance):
+        raise V50Error(f"{label}: the {link.name} fit did not converge: {found.message}")
+    intercept, slope = (float(b) for b in found.x)
+    return Estimate(intercept, slope, float(found.fun), int(found.nit))
+
+
+def increasing(best: Estimate, label: str) -> Estimate:
+    """``best``, refused unless perforation becomes more likely with speed."""
+    if best.slope <= 0.0:
+        raise V50Error(
+            f"{label}: perforation does not become more likely with speed in these shots "
+            f"(fitted slope {best.slope:.3g} <= 0): they show no ballistic limit"
+        )
+    return best
