@@ -91,6 +91,11 @@ _EXPORTS: dict[str, str] = {
     "energy_balance_start": "calibration",
     "fit_dri": "calibration",
     "newton_fit": "calibration",
+    "ProbabilityModel": "calibration",
+    "PstarFit": "calibration",
+    "PstarTableFit": "calibration",
+    "fit_pstar": "calibration",
+    "fit_pstar_by_obliquity": "calibration",
     "validate": "experiment",
     "ValidationReport": "experiment",
     # errors
@@ -144,10 +149,15 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         Calibration,
         CalibrationReport,
         DriFit,
+        ProbabilityModel,
+        PstarFit,
+        PstarTableFit,
         calibrate,
         direct_fit,
         energy_balance_start,
         fit_dri,
+        fit_pstar,
+        fit_pstar_by_obliquity,
         newton_fit,
     )
     from .comparison import Comparison
