@@ -145,9 +145,8 @@ def test_pstar_is_recovered_from_oblique_shots_within_its_uncertainty(
     aluminium_shots, tmp_path, capsys
 ):
     plate_file = tmp_path / "fitted.json"
-    # the preset's P* replaced by 2 mm: the fit does not start from the answer
     args = ["calibrate", str(aluminium_shots), "--fit", "pstar", "--preset", "2024-T3/3.18",
-            "--pstar", "2", "--json", "--out", str(plate_file), *FAST]  # fmt: skip
+            "--json", "--out", str(plate_file), *FAST]  # fmt: skip
     assert main(args) == 0
     found = json.loads(capsys.readouterr().out)
     error = found["pstar_mm"] - 3.0
@@ -241,6 +240,8 @@ PLATE = ["--preset", "2024-T3/3.18"]
         (["--fit", "pstar", "--tolerance", "0", *PLATE], "--tolerance: must be in"),
         (["--fit", "pstar", "--resolution", "0.001", *PLATE], "--resolution: must be in"),
         (["--fit", "pstar", "--failure", "variable-pstar", *PLATE], "does not read"),
+        (["--fit", "pstar", "--pstar", "3", *PLATE], "--pstar: not with --fit pstar"),
+        (["--fit", "pstar", "--set", "plate.pstar=3", *PLATE], "plate.pstar: not with --fit"),
         (["--fit", "pstar", "--alpha-fit", "--failure", "intact", *PLATE], "does not read"),
     ],
 )  # fmt: skip

@@ -64,9 +64,10 @@ def prepare(shots: Shots, sphere: Sphere, question: str, model: ProbabilityModel
     recorded = use & perforated & np.isfinite(residual) & (residual > 0) & (question != "ricochet")
     note = ""
     if model.residual_sigma is None and 0 < recorded.sum() < MIN_RESIDUALS:
+        count = int(recorded.sum())
         note = (
-            f"{int(recorded.sum())} residual speeds not used: too few to fit their scatter "
-            f"(at least {MIN_RESIDUALS}, or give residual_sigma)"
+            f"{count} residual speed{'s' if count > 1 else ''} not used: too few to fit "
+            f"their scatter sigma_r (at least {MIN_RESIDUALS}; or give it: --residual-sigma)"
         )
         recorded[:] = False
     if not use.any():
@@ -289,8 +290,8 @@ def _transition(
 ) -> tuple[float, float, str]:
     """The table's band [m/s]: from the last ricochet with the ricochet-range P* to the
     first perforation with the perforation-range P* (docs/variable-pstar.md), on the
-    line of the group's first sphere; when one is missing both are the other, when both
-    are, the median shot speed; when they cross, both their mean."""
+    group's first line (its smallest sphere); when one is missing both are the other,
+    when both are, the median shot speed; when they cross, both their mean."""
     start = ricochet.bands[0].ricochet_limit
     end = perforation.bands[0].ballistic_limit
     end = end if math.isfinite(end) else math.nan

@@ -106,6 +106,12 @@ def pstar_command(args: argparse.Namespace) -> None:
     shots = Shots.from_csv(args.shots)
     choice = model_choice(args)
     simulation = choice.simulation()
+    if getattr(args, "pstar", None) is not None or "critical_penetration" in choice.plate:
+        flag = choice.plate_flags.get("critical_penetration", "--pstar")
+        raise UsageError(
+            f"{flag}: not with --fit pstar (P* is what it fits, over a fixed range; see "
+            "docs/calibration.md)"
+        )
     if args.preset is None and args.plate_file is None:
         given = {n for n in ("a", "b") if getattr(args, n, None) is not None or n in choice.plate}
         if given != {"a", "b"}:
@@ -243,14 +249,17 @@ def _provenance(
 def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
     e = fit.estimate
     model = fit.model
-    sigma = (
-        "no residual speeds"
-        if math.isnan(e.residual_sigma)
-        else f"sigma_r = {e.residual_sigma:.3g} m/s "
-        + ("(fitted)" if model.residual_sigma is None else "(given)")
-    )
-    if model.residual_sigma is None and e.residual_sigma <= 1.001 * RESIDUAL_SIGMA_BOUNDS[0]:
-        sigma += " (its lower bound: the impact-speed scatter accounts for the residual scatter)"
+    if math.isnan(e.residual_sigma):
+        sigma = "no residual speeds"
+    elif model.residual_sigma is not None:
+        sigma = f"sigma_r = {e.residual_sigma:.3g} m/s (given)"
+    elif e.residual_sigma <= 1.001 * RESIDUAL_SIGMA_BOUNDS[0]:
+        sigma = (
+            f"sigma_r = {e.residual_sigma:.3g} m/s (fitted, its lower bound: the impact-speed "
+            "scatter accounts for the residual scatter)"
+        )
+    else:
+        sigma = f"sigma_r = {e.residual_sigma:.3g} m/s (fitted)"
     alpha = (
         f"alpha* = {math.degrees(e.alpha):.4g} ± {math.degrees(e.alpha_stderr):.2g} deg "
         f"(correlation with P* {e.correlation:+.2f})"
