@@ -88,7 +88,11 @@ class LineModel:
             mine = found.line == index
             at = 0.5 * (found.low[mine] + found.high[mine])
             outcomes = np.concatenate([[found.first[index] // 2], found.above[mine] // 2])
-            edges = np.concatenate([[-np.inf], at, [np.inf]])
+            # a change of the plate's state alone (ricochet, then ricochet after failure)
+            # is no boundary of outcomes
+            change = outcomes[1:] != outcomes[:-1]
+            outcomes = np.concatenate([outcomes[:1], outcomes[1:][change]])
+            edges = np.concatenate([[-np.inf], at[change], [np.inf]])
             on_line = line == index
             out[owner[index]].append(
                 _bands(edges, outcomes, x[on_line], outcome[on_line], exit_speed[on_line])

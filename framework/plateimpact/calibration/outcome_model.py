@@ -136,10 +136,10 @@ def shot_lines(
 class Bands:
     """The model's outcomes along one line: band ``edges`` [m/s] (−∞ first, +∞ last:
     the outcome beyond the line's ends is taken to continue), the ``outcomes`` of the
-    bands, and the residual speeds (``residual`` [m/s]) of the scenes run at ``speeds``
-    [m/s] (sorted) in the line's last run of perforation, which starts at
-    ``ballistic_limit`` [m/s] (NaN if the line does not end in perforation, −∞ if it
-    perforates throughout)."""
+    bands (neighbours differ), and the residual speeds (``residual`` [m/s]) of the
+    scenes run at ``speeds`` [m/s] (sorted) in the line's last run of perforation, which
+    starts at ``ballistic_limit`` [m/s] (NaN if the line does not end in perforation,
+    −∞ if it perforates throughout)."""
 
     edges: np.ndarray
     outcomes: np.ndarray
