@@ -13,6 +13,11 @@ Three steps, after the report's eqs 40–49 (docs/calibration.md):
 
 P* and α* are fixed beforehand (from craters, as in the report). Every model evaluation
 is one batch through :meth:`Simulation.run_batch`.
+
+With a and b known, :func:`fit_pstar` fits P* (and α*) to oblique shots by maximum
+likelihood of their outcomes and residual speeds (:class:`ProbabilityModel`), and
+:func:`fit_pstar_by_obliquity` the report's variable P*: a ricochet-range and a
+perforation-range P* at each obliquity, as the ``variable-pstar`` plug-in's table.
 """
 
 from __future__ import annotations
@@ -27,6 +32,8 @@ from .fits import (
     direct_fit,
     newton_fit,
 )
+from .outcome_model import ProbabilityModel
+from .pstar import PstarFit, PstarRow, PstarTableFit, fit_pstar, fit_pstar_by_obliquity
 from .start import energy_balance_start, model_residual_speeds, swept_volume
 
 __all__ = [
@@ -36,10 +43,16 @@ __all__ = [
     "Calibration",
     "CalibrationReport",
     "DriFit",
+    "ProbabilityModel",
+    "PstarFit",
+    "PstarRow",
+    "PstarTableFit",
     "calibrate",
     "direct_fit",
     "energy_balance_start",
     "fit_dri",
+    "fit_pstar",
+    "fit_pstar_by_obliquity",
     "model_residual_speeds",
     "newton_fit",
     "swept_volume",

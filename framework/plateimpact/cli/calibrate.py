@@ -1,4 +1,5 @@
-"""``plateimpact calibrate``: a and b from shots at normal incidence (eqs 40–49)."""
+"""``plateimpact calibrate``: a and b from shots at normal incidence (eqs 40–49), or with
+``--fit pstar`` P* and α* from oblique shots (:mod:`.calibrate_pstar`)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions
 from ..storage.shots import Shots
 from ..units import g, mm
+from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
 from .common import check_directory, save_figure_atomically, write_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice
 
@@ -33,27 +35,44 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     """Add the ``calibrate`` sub-command to the sub-parsers ``sub``."""
     p = sub.add_parser(
         "calibrate",
-        help="fit a and b to residual speeds at normal incidence (DRI fit, eqs 40-49)",
+        help="fit a and b to residual speeds at normal incidence (DRI fit, eqs 40-49), "
+        "or P* and alpha* to oblique shots (--fit pstar)",
         description="Fit the Poncelet constants a and b to shots at normal incidence: the "
         "DRI fit (eqs 40-41), the report's Newton iteration (eqs 44-49) and a direct "
-        "least-squares fit. P* and alpha* are given (from craters, as in the report).",
+        "least-squares fit; P* and alpha* are given (from craters, as in the report). "
+        "With --fit pstar: a and b given, fit P* (and alpha*) to the outcomes and "
+        "residual speeds of oblique shots by maximum likelihood, or with --by-obliquity "
+        "the report's variable P*.",
     )
     p.add_argument(
         "shots",
         metavar="SHOTS.csv",
-        help="columns impact_speed_m_s,impact_obliquity_deg,residual_speed_m_s"
-        "[,exit_obliquity_deg,outcome] in any order; residual 0: no perforation",
+        help="columns impact_speed_m_s,impact_obliquity_deg and any of outcome, perforated, "
+        "residual_speed_m_s (0: no perforation), exit_obliquity_deg, radius_mm, mass_g, "
+        "weight, source",
+    )
+    p.add_argument(
+        "--fit",
+        choices=("ab", "pstar"),
+        default="ab",
+        help="what to fit: ab (default: a and b at normal incidence) or pstar (P*, and "
+        "alpha* with --alpha-fit, from oblique shots)",
     )
     p.add_argument("--material", default="calibrated", help="material label of the plate")
     p.add_argument(
         "--method",
         choices=("newton", "direct"),
-        default="newton",
-        help="whose a, b are headlined and written to --out (default: newton, the report's)",
+        help="--fit ab: whose a, b are headlined and written to --out (default: newton, the "
+        "report's)",
     )
-    p.add_argument("--out", metavar="PLATE.json", help="write the calibrated plate file here")
+    p.add_argument(
+        "--out",
+        metavar="FILE",
+        help="write the calibrated plate file (JSON) here; with --by-obliquity the P* table (CSV)",
+    )
     p.add_argument("--png", metavar="FILE", help="draw data, DRI curve and model curves here")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_pstar_options(p)
     add_body_options(p, registry)
     add_model_options(p, registry)
     p.set_defaults(command_function=calibrate_command)
@@ -61,6 +80,11 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
 
 def calibrate_command(args: argparse.Namespace) -> None:
     """Run ``plateimpact calibrate``."""
+    if args.fit == "pstar":
+        pstar_command(args)
+        return
+    refuse_pstar_options(args)
+    args.method = args.method or "newton"
     check_directory(args.out, "--out")
     check_directory(args.png, "--png", "figure")
     shots = Shots.from_csv(args.shots)

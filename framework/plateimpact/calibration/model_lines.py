@@ -1,0 +1,121 @@
+"""The model's outcome bands along the lines of shot sets, for many candidate plates at
+once (docs/calibration.md, "P* and α* from oblique shots").
+
+Every line of every candidate runs in the same batches of :func:`plateimpact.limits.locate`
+(a scan and its refinement passes): a batch costs about as much as its slowest scene's
+steps, so twenty candidates cost about twice what one does.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+
+import attrs
+import numpy as np
+
+from ..batch import SceneBatch
+from ..bodies import Plate, Sphere
+from ..limits import locate, regime_codes
+from ..results import Outcome
+from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
+from .outcome_model import Bands, ShotLines
+
+
+@attrs.frozen
+class Cost:
+    """What the model runs took: candidate shot sets evaluated, scene batches, seconds."""
+
+    evaluations: int = 0
+    batches: int = 0
+    seconds: float = 0.0
+
+
+class LineModel:
+    """The bands of shot-set lines for candidate plate constants.
+
+    ``plate`` gives every constant the candidates do not replace; ``sphere`` is a
+    placeholder for the batch's columns (each line has its own radius and mass);
+    ``resolution`` and ``tolerance`` [m/s] are the finder's (docs/limits.md).
+    """
+
+    def __init__(
+        self,
+        simulation: Simulation,
+        sphere: Sphere,
+        plate: Plate,
+        resolution: float,
+        tolerance: float,
+    ) -> None:
+        self.simulation, self.sphere, self.plate = simulation, sphere, plate
+        self.resolution, self.tolerance = resolution, tolerance
+        self.cost = Cost()
+
+    def bands(
+        self, sets: Sequence[ShotLines], constants: Sequence[Mapping[str, float]]
+    ) -> list[list[Bands]]:
+        """For each pair of a shot set and plate constants [SI] (replacing the plate's),
+        the bands of each of the set's lines, all found in the same batches."""
+        began = time.perf_counter()
+        owner = np.concatenate([np.full(s.lines, k) for k, s in enumerate(sets)])
+        obliquity = np.concatenate([s.obliquity for s in sets])
+        radius = np.concatenate([s.radius for s in sets])
+        mass = np.concatenate([s.mass for s in sets])
+        replaced = {name: np.array([c[name] for c in constants])[owner] for name in constants[0]}
+        base = SceneBatch.grid(self.sphere, self.plate, [1.0], [0.0])
+        samples: list[tuple[np.ndarray, ...]] = []
+
+        def evaluate(line: np.ndarray, x: np.ndarray) -> np.ndarray:
+            batch = base.take(np.zeros(line.size, dtype=np.int64)).with_columns(
+                impact_speed=x,
+                impact_obliquity=obliquity[line],
+                radius=radius[line],
+                mass=mass[line],
+                **{name: values[line] for name, values in replaced.items()},
+            )
+            result = self.simulation.run_batch(batch, chunk_size=DEFAULT_CHUNK_SIZE)
+            codes = regime_codes(result)
+            samples.append((line, x, codes // 2, np.asarray(result.exit_speed)))
+            return codes
+
+        starts = np.concatenate([s.start for s in sets])
+        ends = np.concatenate([s.end for s in sets])
+        found = locate(evaluate, starts, ends, self.resolution, self.tolerance)
+        line, x, outcome, exit_speed = (np.concatenate(c) for c in zip(*samples, strict=True))
+        out: list[list[Bands]] = [[] for _ in sets]
+        for index in range(owner.size):
+            mine = found.line == index
+            at = 0.5 * (found.low[mine] + found.high[mine])
+            outcomes = np.concatenate([[found.first[index] // 2], found.above[mine] // 2])
+            # a change of the plate's state alone (ricochet, then ricochet after failure)
+            # is no boundary of outcomes
+            change = outcomes[1:] != outcomes[:-1]
+            outcomes = np.concatenate([outcomes[:1], outcomes[1:][change]])
+            edges = np.concatenate([[-np.inf], at[change], [np.inf]])
+            on_line = line == index
+            out[owner[index]].append(
+                _bands(edges, outcomes, x[on_line], outcome[on_line], exit_speed[on_line])
+            )
+        self.cost = Cost(
+            self.cost.evaluations + len(sets),
+            self.cost.batches + len(samples),
+            self.cost.seconds + time.perf_counter() - began,
+        )
+        return out
+
+
+def _bands(
+    edges: np.ndarray, outcomes: np.ndarray, x: np.ndarray, outcome: np.ndarray, g: np.ndarray
+) -> Bands:
+    """The bands of one line, with the samples of its last run of perforation."""
+    perforation = outcomes == Outcome.PERFORATION
+    if not perforation[-1]:
+        return Bands(edges, outcomes, np.zeros(0), np.zeros(0), math.nan)
+    k = outcomes.size - 1
+    while k > 0 and perforation[k - 1]:
+        k -= 1
+    limit = float(edges[k])
+    keep = (outcome == Outcome.PERFORATION) & (x >= limit)
+    order = np.argsort(x[keep], kind="stable")
+    return Bands(edges, outcomes, x[keep][order], g[keep][order], limit)
