@@ -27,6 +27,7 @@ try:
         fig38_44_sae1010_1_47mm,
     )
     from ._family import run_and_plot, tagged
+    from .experiment import experiment
 except ImportError:  # run as a script
     import fig11_17_6061t6_9_53mm
     import fig18_24_2024t3_6_35mm
@@ -35,6 +36,7 @@ except ImportError:  # run as a script
     import fig35_37_craters_60deg
     import fig38_44_sae1010_1_47mm
     from _family import run_and_plot, tagged
+    from experiment import experiment
 
 FAMILIES = (
     fig11_17_6061t6_9_53mm,
@@ -112,6 +114,7 @@ def reproduce(
     figures = [run_and_plot(s, out, archive, progress, **rerun, **drawing) for s in studies]
     figures.append(run_and_plot(craters, out, archive, progress, craters=True, **rerun, **drawing))
     figures += outcome_maps(out, archive, **rerun, **drawing)[1]
+    figures += experiment(out, dpi, suffix, resume)  # validate, V50, P* on synthetic shots
     return archive, figures
 
 

@@ -378,8 +378,10 @@ def test_reproduce_writes_one_archive_and_a_figure_per_family(tmp_path, capsys):
     assert archive.results("craters_60deg/default").craters is not None
     maps = [f"map_{plate.replace('/', '_')}" for plate in pi.presets.PLATES]
     assert stored_limits(out / "report.h5") == maps  # and the five plates' outcome maps
-    pngs = sorted(out.glob("*.png"))
-    assert len(pngs) == 8 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
+    pngs = sorted(out.glob("*.png"))  # and the experiment's validate and V50 figures
+    assert len(pngs) == 11 and all(p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
+    table = (out / "pstar_table_SAE1010_1.47mm.csv").read_text().splitlines()
+    assert table[0].startswith("obliquity_deg,ricochet_pstar_mm,perforation_pstar_mm")
     assert str(out / "report.h5") in capsys.readouterr().out
     for family in ("6061-T6_9.53mm", "SAE1010_1.47mm"):  # a journal page, 7.2 in at 150 dpi
         assert (out / f"{family}.png").read_bytes()[16:20] == (1080).to_bytes(4, "big")

@@ -21,7 +21,7 @@ from ..storage.provenance import versions
 from ..storage.shots import Shots
 from ..units import g, mm
 from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
-from .common import check_directory, save_figure_atomically, write_atomically
+from .common import add_dpi_option, check_directory, save_figure_atomically, write_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice
 
 if TYPE_CHECKING:
@@ -71,6 +71,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         help="write the calibrated plate file (JSON) here; with --by-obliquity the P* table (CSV)",
     )
     p.add_argument("--png", metavar="FILE", help="draw data, DRI curve and model curves here")
+    add_dpi_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_pstar_options(p)
     add_body_options(p, registry)
@@ -105,7 +106,7 @@ def calibrate_command(args: argparse.Namespace) -> None:
         extra = {"calibration": {**provenance, "model": summary["model"]}}
         write_atomically(args.out, plate_file_text(chosen.plate, extra), "--out")
     if args.png is not None:
-        save_figure_atomically(_figure(report, sphere, simulation), args.png)
+        save_figure_atomically(_figure(report, sphere, simulation), args.png, dpi=args.dpi)
     if args.json:
         print(json.dumps(summary))
     else:

@@ -19,7 +19,7 @@ from ..registry import PluginRegistry
 from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP
-from .common import UsageError, check_directory, save_figure_atomically
+from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
 MIL_STD = "mil-std-662f"
@@ -95,6 +95,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     add_body_options(probe, registry)
     add_model_options(probe, registry)
     model_options = sorted(vars(probe.parse_args([])))
+    add_dpi_option(p)
     p.set_defaults(command_function=v50_command, model_options=model_options)
 
 
@@ -209,7 +210,8 @@ def v50_command(args: argparse.Namespace) -> None:
                   groups[o].weight, r, model_limits.get(o))
             for o, r in results.items()
         ]  # fmt: skip
-        save_figure_atomically(v50_figure(panels, title=args.shots, model=model), args.png)
+        figure = v50_figure(panels, title=args.shots, model=model)
+        save_figure_atomically(figure, args.png, dpi=args.dpi)
     rows = [_json(args, o, r, groups[o].labels, model_limits, model) for o, r in results.items()]
     if args.json:
         print(json.dumps(rows[0] if len(rows) == 1 else rows))

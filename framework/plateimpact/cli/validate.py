@@ -13,7 +13,7 @@ from ..experiment import MEASURED, PREDICTED, ValidationReport, validate
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..storage.shots import Shots
-from .common import check_directory, save_figure_atomically
+from .common import add_dpi_option, check_directory, save_figure_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice
 
 #: Disagreeing shots listed in the text output (--json lists all).
@@ -48,6 +48,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     )
     add_body_options(p, registry)
     add_model_options(p, registry)
+    add_dpi_option(p)
     p.set_defaults(command_function=validate_command)
 
 
@@ -69,7 +70,7 @@ def validate_command(args: argparse.Namespace) -> None:
 
             figure = validation_figure(report, simulation, title=label)
     if args.png is not None:
-        save_figure_atomically(figure, args.png)
+        save_figure_atomically(figure, args.png, dpi=args.dpi)
     if args.json:
         print(json.dumps({"shots_file": args.shots, "plate_label": label, **report.to_json()}))
     else:

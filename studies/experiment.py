@@ -1,0 +1,92 @@
+"""The model against (synthetic) experiment: validate, V50 and the variable-P* fit on the
+example shot files of studies/data/, the 1.47-mm SAE 1010 plate (what `plateimpact
+reproduce` adds to its output, docs/experiment.md).
+
+python studies/experiment.py [--out DIR]
+
+The files are **synthetic** (their headers say how they were made: the model's own
+outcomes with stated noise, studies/make_oblique_shots.py and make_v50_shots.py), so
+what this shows is that the tools give back what was put in: the variable-P* model
+agrees with the shots made from it and the constant-P* model does not; V50 lies near the
+model's ballistic limit; the by-obliquity fit gives a P* table near the one the shots
+were made from.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import plateimpact as pi
+from plateimpact import limits, plotting, presets
+from plateimpact.experiment.figure import validation_figure
+from plateimpact.storage.output import write_text
+from plateimpact.v50.figure import Panel, v50_figure
+
+DATA = Path(__file__).resolve().parent / "data"
+PLATE = "SAE1010/1.47"
+OBLIQUE = DATA / "oblique_SAE1010_1.47mm_variable_pstar.csv"
+GO_NO_GO = DATA / "gonogo_SAE1010_1.47mm.csv"
+MODELS = {"constant-pstar": "plugging", "variable-pstar": "variable-pstar"}
+
+
+def outputs(out: Path, suffix: str = "png") -> list[Path]:
+    """What :func:`experiment` writes into ``out``."""
+    return [
+        *(out / f"validate_SAE1010_1.47mm_{name}.{suffix}" for name in MODELS),
+        out / f"v50_SAE1010_1.47mm.{suffix}",
+        out / "pstar_table_SAE1010_1.47mm.csv",
+    ]
+
+
+def experiment(
+    out: Path, dpi: float = plotting.DPI, suffix: str = "png", resume: bool = False
+) -> list[Path]:
+    """Draw the validation of both mild-steel models, the V50 fits beside the model's
+    ballistic limits, and write the by-obliquity P* table (CSV with standard errors)
+    into ``out``; returns the paths written. With ``resume``, what is there is kept
+    (it depends only on the shot files and the model)."""
+    plate, sphere = presets.plate(PLATE), presets.DEFAULT_SPHERE
+    *validations, v50, table = outputs(out, suffix)
+    shots = pi.Shots.from_csv(OBLIQUE)
+    for (name, failure), path in zip(MODELS.items(), validations, strict=True):
+        if resume and path.exists():
+            continue
+        simulation = pi.Simulation.from_names(failure=failure)
+        report = pi.validate(simulation, sphere, plate, shots)
+        title = (f"{PLATE}, {name} model against {OBLIQUE.name} (synthetic): "
+                 f"outcome agreement {report.agreement:.1%}")  # fmt: skip
+        plotting.save(validation_figure(report, simulation, title=title), str(path), dpi=dpi)
+    if not (resume and v50.exists()):
+        go_no_go = pi.Shots.from_csv(GO_NO_GO).groups_by_obliquity()
+        simulation = pi.Simulation.from_names()
+        model = limits.along_speed(simulation, sphere, plate, list(go_no_go), (50.0, 2000.0))
+        panels = [
+            Panel(f"{math.degrees(obliquity):g} deg", group.impact_speed, group.perforated,
+                  group.weight, pi.fit_v50(group.impact_speed, group.perforated, group.weight),
+                  line.ballistic_limit)
+            for (obliquity, group), line in zip(go_no_go.items(), model.lines, strict=True)
+        ]  # fmt: skip
+        title = f"{GO_NO_GO.name} (synthetic)"
+        figure = v50_figure(panels, title=title, model=f"{PLATE}, plugging")
+        plotting.save(figure, str(v50), dpi=dpi)
+    if not (resume and table.exists()):
+        fitted = pi.fit_pstar_by_obliquity(shots, plate, sphere=sphere)
+        write_text(table, fitted.csv_text(), "table")
+    return outputs(out, suffix)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default=".", help="directory for the figures and the table")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    for path in experiment(Path(args.out)):
+        print(f"wrote:   {path}")
+    print(f"({time.perf_counter() - start:.1f} s)")
+
+
+if __name__ == "__main__":
+    main()
