@@ -97,30 +97,42 @@ def test_shots_at_another_pstar_disagree_exactly_between_the_two_models_boundari
 
 
 def assert_nearest_change(d) -> None:
-    """Direct runs of our model: no change of what was compared (the outcome, or
-    perforation for a go/no-go shot) nearer than the reported distance, and a change
-    just beyond it on the side of the reported boundary."""
+    """Direct runs of our model: no speed nearer than the reported distance gives what
+    was measured (the outcome, or perforation for a go/no-go shot), and a speed just
+    beyond the reported boundary does."""
     go_no_go = d.measured in ("perforated", "not perforated")
     near = np.linspace(d.impact_speed - d.distance + 0.05, d.impact_speed + d.distance - 0.05, 200)
     beyond = d.boundary + 0.05 * np.sign(d.boundary - d.impact_speed)
-    result = SIMULATION.run_batch(
-        pi.SceneBatch.grid(SPHERE, PLATE, np.append(near, beyond), [d.impact_obliquity])
+    speeds = np.append(near, [beyond, d.impact_speed])
+    everything = SIMULATION.run_batch(
+        pi.SceneBatch.grid(SPHERE, PLATE, speeds, [d.impact_obliquity])
     )
-    seen = result.outcome == pi.Outcome.PERFORATION if go_no_go else result.outcome
-    assert (seen[:-1] == seen[0]).all() and seen[-1] != seen[0]
-    assert pi.Outcome(int(result.outcome[0])).label == d.predicted
+    assert pi.Outcome(int(everything.outcome[-1])).label == d.predicted  # at the shot's speed
+    result = everything.take(np.arange(speeds.size - 1))
+    if go_no_go:
+        agrees = (result.outcome == pi.Outcome.PERFORATION) == (d.measured == "perforated")
+    else:
+        agrees = np.array([pi.Outcome(int(o)).label == d.measured for o in result.outcome])
+    assert not agrees[:-1].any() and agrees[-1]
 
 
-def test_the_boundary_is_one_across_which_what_was_compared_changes():
+def test_the_boundary_is_the_nearest_beyond_which_the_model_gives_what_was_measured():
     # At 45 deg the plate fails at 184.6 m/s (ricochet after failure: the same outcome),
-    # the sphere embeds from 206.0 and perforates from 208.75 m/s.
+    # the sphere embeds from 206.0 and perforates from 208.75 m/s: a perforation measured
+    # at 190 m/s is 18.75 m/s from agreeing, not 16 (embedment would not agree either).
     text = (
         "impact_speed_m_s,impact_obliquity_deg,outcome,perforated\n190,45,perforation,\n190,45,,1\n"
     )
     report = pi.validate(SIMULATION, SPHERE, PLATE, pi.Shots.from_csv_text(text))
     outcome, go_no_go = report.disagreements
-    assert outcome.boundary == pytest.approx(206.0, abs=0.1)
+    assert outcome.boundary == pytest.approx(208.75, abs=0.1)
     assert go_no_go.boundary == pytest.approx(208.75, abs=0.1)
+    embedded = pi.Shots.from_csv_text(
+        "impact_speed_m_s,impact_obliquity_deg,outcome\n190,45,embedment\n"
+    )
+    (d,) = pi.validate(SIMULATION, SPHERE, PLATE, embedded).disagreements
+    assert d.boundary == pytest.approx(206.0, abs=0.1)  # the embedment band's near edge
+    assert_nearest_change(d)
     for d in report.disagreements:
         assert_nearest_change(d)
 

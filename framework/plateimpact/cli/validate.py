@@ -30,8 +30,8 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         "matrix of outcomes (measured -> predicted; go/no-go shots perforated or not), the "
         "weighted agreement, the residual-speed error (RMS and bias, model minus measured) "
         "and exit-obliquity error (RMS) where shot and model both leave the plate the same "
-        "way, and each disagreeing shot with its distance to the nearest boundary of the "
-        "model along impact speed.",
+        "way, and each disagreeing shot with its distance along impact speed to the nearest "
+        "boundary of the model beyond which it gives what was measured.",
     )
     p.add_argument(
         "shots",
@@ -109,7 +109,7 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
         print(f"exit obliquity, model - measured: rms {rms:.3g} deg over {pairs} shots")
     wrong = report.disagreements
     if wrong:
-        print(f"{len(wrong)} shots disagree (distance to the nearest boundary of the model):")
+        print(f"{len(wrong)} shots disagree (distance to the nearest speed the model agrees at):")
     for d in wrong[:LISTED]:
         where = (
             f"{d.distance:.3g} m/s from the boundary at {d.boundary:.2f} m/s"

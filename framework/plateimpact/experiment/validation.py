@@ -6,14 +6,16 @@ an outcome is compared outcome to outcome; a go/no-go shot (only ``perforated`` 
 perforated or not. Speeds and angles are compared where the shot and the model both
 leave the plate the same way (both perforate, or both ricochet and the shot records the
 ricochet's exit speed). A disagreeing shot's distance is the distance along impact speed,
-at its obliquity, to the nearest boundary of the model across which what was compared
-changes (the outcome, or perforation for a go/no-go shot), located by
+at its obliquity, to the nearest boundary of the model beyond which it gives what was
+measured (the outcome, or perforation or not for a go/no-go shot): how far the shot's
+speed is from one at which the model agrees, located by
 :func:`plateimpact.limits.along_speed` (docs/experiment.md).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from concurrent.futures import Executor
 from typing import Any
 
@@ -22,7 +24,14 @@ import numpy as np
 
 from ..bodies import MASS, RADIUS, Plate, Sphere
 from ..errors import ShotDataError
-from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE, LimitLine, Limits, along_speed
+from ..limits import (
+    SPEED_RESOLUTION,
+    SPEED_TOLERANCE,
+    LimitLine,
+    Limits,
+    Regime,
+    along_speed,
+)
 from ..results import Outcome
 from ..scene import IMPACT_SPEED
 from ..simulation import Simulation
@@ -189,20 +198,26 @@ def boundary_speeds(shots: Shots) -> tuple[float, float]:
     return low, high
 
 
-def _nearest(line: LimitLine, speed: float, go_no_go: bool) -> float | None:
-    """The boundary of ``line`` nearest ``speed`` [m/s] across which the outcome (or, for
-    a go/no-go shot, perforation) changes; None if the line has none."""
-    perforates = Outcome.PERFORATION
-    changes = [
-        b.at
-        for b in line.boundaries
-        if (
-            (b.below.outcome is perforates) != (b.above.outcome is perforates)
-            if go_no_go
-            else b.below.outcome is not b.above.outcome
-        )
+def _nearest(line: LimitLine, speed: float, measured: Callable[[Regime], bool]) -> float | None:
+    """The boundary of ``line`` nearest ``speed`` [m/s] beyond which the model gives what
+    was measured (``measured(regime)``: the outcome, or for a go/no-go shot whether it
+    perforated): the near edge of the nearest band that agrees. None if no band of the
+    line agrees (the line's own ends are not boundaries)."""
+    edges = [
+        edge
+        for k, band in enumerate(line.bands)
+        if measured(band.regime)
+        for edge, inner in ((band.start, k > 0), (band.end, k < len(line.bands) - 1))
+        if inner
     ]
-    return min(changes, key=lambda at: abs(at - speed)) if changes else None
+    return min(edges, key=lambda at: abs(at - speed)) if edges else None
+
+
+def _measured_regime(outcome: int, perforated: bool) -> Callable[[Regime], bool]:
+    """Whether a model regime gives what a shot measured."""
+    if outcome:
+        return lambda regime: regime.outcome is Outcome(outcome)
+    return lambda regime: (regime.outcome is Outcome.PERFORATION) == perforated
 
 
 def _disagreements(
@@ -233,7 +248,8 @@ def _disagreements(
         found.append(limits)
         for i in mine:
             line = limits.lines[int(np.searchsorted(obliquities, shots.impact_obliquity[i]))]
-            boundary[int(i)] = _nearest(line, shots.impact_speed[i], shots.outcome[i] == 0)
+            wanted = _measured_regime(int(shots.outcome[i]), bool(shots.perforated[i]))
+            boundary[int(i)] = _nearest(line, shots.impact_speed[i], wanted)
     classes = measured_classes(shots)
     disagreements = tuple(
         Disagreement(
