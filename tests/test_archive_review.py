@@ -152,6 +152,9 @@ def test_reproduce_twice_on_the_command_line(tmp_path, monkeypatch):
     assert len(pi.Archive(out / "report.h5").runs()) == 4
     code, _, err = run_cli(["reproduce", "--out", str(out), "--resume", "--overwrite"])
     assert code == 2 and "not allowed with" in err
+    for tag in ("", "a/b", "two words"):
+        code, _, err = run_cli(["reproduce", "--out", str(out), "--as", tag])
+        assert_one_line(code, err, "--as", "printable tag")
 
 
 def test_a_format_1_archive_is_read_refused_for_appends_and_upgraded(tmp_path):

@@ -7,6 +7,7 @@ import contextlib
 import io
 import math
 import struct
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -185,6 +186,10 @@ def test_normal_incidence_says_what_the_obliquity_is_instead_of_a_flat_line(
 # The command line: --dpi, and the format from the file name.
 
 
+#: The example shot files (studies/data).
+SHOTS = Path(__file__).resolve().parents[1] / "studies" / "data"
+
+
 def run_cli(argv):
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
@@ -255,6 +260,10 @@ def test_a_bad_dpi_is_one_line_naming_the_flag_and_the_range(archive, tmp_path, 
          f"--dpi={dpi}"],
         ["map", "--preset", "2024-T3/3.18", "--png", str(png), f"--dpi={dpi}"],
         ["compare", str(archive), "plugging", "plugging", "--png", str(png), f"--dpi={dpi}"],
+        ["validate", str(SHOTS / "oblique_SAE1010_1.47mm_pstar4.6.csv"), "--preset",
+         "SAE1010/1.47", "--png", str(png), f"--dpi={dpi}"],
+        ["v50", str(SHOTS / "gonogo_SAE1010_1.47mm.csv"), "--by-obliquity", "--png", str(png),
+         f"--dpi={dpi}"],
     ):  # fmt: skip
         code, err = run_cli(argv)
         assert code == 2 and err.count("\n") == 1, err
