@@ -28,8 +28,9 @@ import attrs
 import numpy as np
 
 from ..errors import V50Error
-from .likelihood import Link, maximum, prepared
+from .likelihood import Link, prepared
 from .profile import Interval
+from .solver import maximum
 
 
 @attrs.frozen

@@ -15,16 +15,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from .bootstrap import bootstrap_intervals
-from .likelihood import (
-    PROBIT,
-    check_arrays,
-    check_shots,
-    increasing,
-    link_of,
-    maximum,
-    prepared,
-)
+from .likelihood import PROBIT, check_arrays, check_shots, increasing, link_of, prepared
 from .profile import Interval, profile_intervals
+from .solver import maximum
 
 #: The quantiles reported, by name: the speed at which P(perforation) is p.
 LEVELS = {"v50": 0.5, "v10": 0.1, "v90": 0.9}
@@ -124,16 +117,22 @@ def fit_v50(
     default 1) have one value per shot. ``method`` is ``probit`` (F = Φ) or ``logit``
     (the logistic CDF). ``confidence`` sets the intervals' level; ``bootstrap``
     resamples (0: none) are drawn with ``rng`` (a Generator, or a seed: the default 0
-    makes a fit reproducible). ``label`` names the shots in error messages.
+    makes a fit reproducible). ``label`` names the shots in error messages. The shots
+    are taken in one order (by speed, outcome, weight), so the fit and its bootstrap do
+    not depend on the order given.
 
     Raises :class:`~plateimpact.errors.V50Error` (one line) for fewer than 4 shots, only
-    one outcome, no overlap of the outcomes' speeds (the likelihood has no maximum), a
-    fit that finds perforation less likely at higher speeds, or one that does not
-    converge; :class:`~plateimpact.errors.ParameterError` for bad arguments.
+    one outcome, outcomes separated by a speed (the likelihood has no maximum), or a fit
+    that finds perforation less likely at higher speeds (a fit that does not converge
+    would be refused too: none is known);
+    :class:`~plateimpact.errors.ParameterError` for bad arguments.
     """
     link = link_of(method)
     _check_options(confidence, bootstrap)
     v, y, w = check_arrays(speed, perforated, weight)
+    # One order whatever the file's: the same numbers, bootstrap draws included.
+    order = np.lexsort((w, y, v))
+    v, y, w = v[order], y[order], w[order]
     check_shots(v, y, w, label)
     shots = prepared(v, y, w)
     best = increasing(maximum(shots, link, label), label)
