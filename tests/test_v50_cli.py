@@ -180,3 +180,25 @@ def test_the_shipped_go_no_go_example_is_synthetic_and_centred_on_the_model():
     profile = min(nll(s) for s in np.geomspace(1.0, 1e4, 4000))
     assert 2 * (profile + fits[0].log_likelihood) < stats.chi2.ppf(0.95, 1)
     assert fits[0].v10_ci_m_s[0] is None and fits[0].v10_ci_m_s[1] is not None
+
+
+WEIGHTED = Path(__file__).resolve().parent / "data" / "v50_weighted_13_rows.csv"
+
+
+def test_resamples_no_fit_converged_on_are_reported(capsys, monkeypatch):
+    """Every resample's fit made to fail: the text counts them failed, left out; the
+    bootstrap intervals are '-' (none), the JSON's bootstrap_failed the resamples."""
+
+    def fails(shots, link, label):
+        raise pi.V50Error(f"{label}: the {link.name} fit did not converge: injected")
+
+    monkeypatch.setattr("plateimpact.v50.bootstrap.maximum", fails)
+    assert main(["v50", str(WEIGHTED), "--bootstrap", "40"]) == 0
+    text = capsys.readouterr().out
+    out = run_json(capsys, WEIGHTED, "--bootstrap", "40")
+    failed = out["bootstrap_failed"]
+    assert failed == 40 - out["bootstrap_separated"] - out["bootstrap_flat"] > 30
+    assert f"{failed} failed (no fit converged: left out)" in text
+    assert out["sigma_bootstrap_ci_m_s"] is None
+    sigma_line = next(line for line in text.splitlines() if line.startswith("  sigma"))
+    assert sigma_line.endswith("]  -")  # the profile interval, then no bootstrap one

@@ -1,5 +1,6 @@
 """V50 fits that never refuse valid data: the fit from any row order is statsmodels'
-binomial GLM fit of the same rows (an independent solver: IRLS, frequency weights). The
+binomial GLM fit of the same rows (an independent solver: IRLS, frequency weights); the
+bootstrap refits what a solver once failed on rather than counting it flat. The
 data sets main@86344fb refused depending on the row order are in tests/data (with how
 they were found); benchmarks/v50_refusals.py measures before/after."""
 
@@ -18,6 +19,8 @@ from plateimpact.errors import V50Error
 from plateimpact.storage.shots import Shots
 from plateimpact.v50 import METHODS, fit_v50
 from plateimpact.v50 import solver as solver_module
+from plateimpact.v50.bootstrap import bootstrap_intervals
+from plateimpact.v50.fit import LEVELS
 from plateimpact.v50.likelihood import LINKS, check_shots, prepared
 from plateimpact.v50.solver import maximum
 
@@ -112,6 +115,60 @@ def test_fit_v50_gives_one_answer_whatever_the_row_order(name, method):
         order = rng.permutation(speed.size)
         fit = fit_v50(speed[order], perforated[order], weight[order], method=method, bootstrap=20)
         assert fit.to_json() == first
+
+
+def test_the_bootstrap_refits_resamples_a_solver_failed_on_rather_than_counting_them_flat():
+    """The 13-row file's probit bootstrap, 200 resamples at seed 11 (two of which main's
+    solver did not converge on, and counted flat, σ = ∞), drawn from the GLM's curve:
+    each resample refitted here by the GLM, separated ones read as σ = 0 and those with
+    no rise as flat (σ = ∞), as plateimpact.v50.bootstrap documents. The σ interval is the
+    5th and 195th of the 200 σ sorted, ((1 ∓ 0.95)/2 × 200); the counts agree."""
+    speed, perforated, weight = from_file("v50_weighted_13_rows.csv")
+    (v50, sigma), params = glm(speed, perforated, weight, "probit")
+    resamples, seed = 200, 11
+    found = bootstrap_intervals(speed, perforated, weight, LINKS["probit"], (v50, sigma),
+                                resamples, seed, 0.95, LEVELS)  # fmt: skip
+    # The draws, as documented: per row a binomial count of perforations among its rounds.
+    p = stats.norm.cdf((speed - v50) / sigma)
+    goes = np.random.default_rng(seed).binomial(weight.astype(np.int64), p, (resamples, speed.size))
+    sigmas, flat, separated = [], 0, 0
+    for count in goes:
+        rows_v = np.concatenate([speed, speed])
+        rows_y = np.repeat([True, False], speed.size)
+        rows_w = np.concatenate([count, weight - count]).astype(float)
+        go, no_go = rows_y & (rows_w > 0), ~rows_y & (rows_w > 0)
+        if rows_v[no_go].max() <= rows_v[go].min():
+            sigmas.append(0.0)
+            separated += 1
+            continue
+        if rows_v[go].max() > rows_v[no_go].min():
+            (_, resampled), beta = glm(rows_v, rows_y, rows_w, "probit", start=params)
+            if beta[1] > 0:
+                sigmas.append(resampled)
+                continue
+        sigmas.append(math.inf)
+        flat += 1
+    ordered = np.sort(sigmas)
+    low, high = found.intervals["sigma"]
+    assert (found.separated, found.flat) == (separated, flat)
+    assert high == pytest.approx(ordered[194], rel=1e-7)
+    assert low == pytest.approx(ordered[4], rel=1e-7)  # main took the 6th
+    assert found.failed == 0
+
+
+def test_a_resample_no_solver_fits_is_left_out_and_counted(monkeypatch):
+    """With every resample's fit made to fail, none is read as flat: all are counted
+    failed, and σ gets no interval (more left out than a tail holds)."""
+    speed, perforated, weight = from_file("v50_weighted_13_rows.csv")
+
+    def fails(shots, link, label):
+        raise V50Error(f"{label}: the {link.name} fit did not converge: injected")
+
+    monkeypatch.setattr("plateimpact.v50.bootstrap.maximum", fails)
+    fit = fit_v50(speed, perforated, weight, bootstrap=50)
+    assert fit.bootstrap_failed == 50 - fit.bootstrap_separated - fit.bootstrap_flat
+    assert fit.bootstrap_failed > 40
+    assert fit.sigma_bootstrap_ci_m_s is None and fit.v50_bootstrap_ci_m_s is None
 
 
 def test_the_fallback_solver_takes_over_where_newton_stops_short(monkeypatch):

@@ -277,9 +277,11 @@ def _text(row: dict[str, Any]) -> str:
             lines.append(f"  {name:6s}{row[f'{key}_m_s']:9.4g} m/s  {profile}{boot}")
         low, high = row["mixed_zone_m_s"]
         note = f"zone of mixed results {low:g}-{high:g} m/s"
-        if row["bootstrap_separated"] or row["bootstrap_flat"]:
-            note += (f"; of the resamples {row['bootstrap_separated']} separated (sigma 0), "
-                     f"{row['bootstrap_flat']} flat (no rise with speed)")  # fmt: skip
+        kinds = (("bootstrap_separated", "separated (sigma 0)"),
+                 ("bootstrap_flat", "flat (no rise with speed)"),
+                 ("bootstrap_failed", "failed (no fit converged: left out)"))  # fmt: skip
+        if resamples:  # said even when 0: a reader need not guess
+            note += "; of the resamples " + ", ".join(f"{row[k]} {what}" for k, what in kinds)
         lines.append(f"  {note}")
     if "model" in row:
         limit = row["model_ballistic_limit_m_s"]

@@ -36,8 +36,9 @@ class V50Fit:
     fitted curve. Each ``*_ci_m_s`` is the profile-likelihood interval [low, high] at
     ``confidence``, each ``*_bootstrap_ci_m_s`` the parametric-bootstrap percentile
     interval of ``bootstrap_resamples`` resamples (None if 0), of which
-    ``bootstrap_separated`` had outcomes that did not overlap and ``bootstrap_flat`` no
-    rise of perforation with speed (plateimpact.v50.bootstrap). An interval end is
+    ``bootstrap_separated`` had outcomes that did not overlap, ``bootstrap_flat`` no
+    rise of perforation with speed, and ``bootstrap_failed`` no fit any solver converged
+    on (left out; none is known) (plateimpact.v50.bootstrap). An interval end is
     None where the data do not bound it (for a speed: above 0 m/s). ``mixed_zone_m_s`` is
     [the slowest perforation, the fastest non-perforation]. ``fit_v50`` raises rather
     than return a fit that did not converge, so ``converged`` is True on every fit it
@@ -62,6 +63,7 @@ class V50Fit:
     bootstrap_resamples: int
     bootstrap_separated: int
     bootstrap_flat: int
+    bootstrap_failed: int
     shots: int
     perforations: int
     mixed_zone_m_s: tuple[float, float]
@@ -163,6 +165,7 @@ def fit_v50(
         bootstrap_resamples=bootstrap,
         bootstrap_separated=resampled.separated,
         bootstrap_flat=resampled.flat,
+        bootstrap_failed=resampled.failed,
         shots=int(used.sum()),
         perforations=int((used & y).sum()),
         mixed_zone_m_s=(float(v[used & y].min()), float(v[used & ~y].max())),
