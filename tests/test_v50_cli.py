@@ -185,6 +185,24 @@ def test_the_shipped_go_no_go_example_is_synthetic_and_centred_on_the_model():
 WEIGHTED = Path(__file__).resolve().parent / "data" / "v50_weighted_13_rows.csv"
 
 
+def test_weighted_rows_are_counted_as_rounds_and_the_file_main_refused_is_fitted(capsys):
+    """The 13-row file of 53 rounds (main refused it in this order, 'did not converge'):
+    --json says rounds 53 and rows 13, shots the rounds (it said 13), perforations the
+    perforating rounds; the text says both."""
+    out = run_json(capsys, WEIGHTED, "--bootstrap", "30")
+    shots = pi.Shots.from_csv(WEIGHTED)
+    fit = fit_v50(shots.impact_speed, shots.perforated, shots.weight, bootstrap=30)
+    assert (out["rounds"], out["rows"], out["shots"], out["perforations"]) == (53, 13, 53, 25)
+    assert out["v50_m_s"] == fit.v50_m_s and out["bootstrap_failed"] == 0
+    assert main(["v50", str(WEIGHTED), "--bootstrap", "0"]) == 0
+    text = capsys.readouterr().out
+    assert f"{WEIGHTED} at 0 deg: 53 shots (13 rows), 25 perforated; probit fit" in text
+    assert main(["v50", str(WEIGHTED), "--bootstrap", "20"]) == 0
+    assert "of the resamples 0 separated (sigma 0), 0 flat (no rise with speed), 0 failed" in (
+        capsys.readouterr().out
+    )
+
+
 def test_resamples_no_fit_converged_on_are_reported(capsys, monkeypatch):
     """Every resample's fit made to fail: the text counts them failed, left out; the
     bootstrap intervals are '-' (none), the JSON's bootstrap_failed the resamples."""

@@ -1,8 +1,9 @@
 """V50 fits that never refuse valid data: the fit from any row order is statsmodels'
 binomial GLM fit of the same rows (an independent solver: IRLS, frequency weights); the
-bootstrap refits what a solver once failed on rather than counting it flat. The
-data sets main@86344fb refused depending on the row order are in tests/data (with how
-they were found); benchmarks/v50_refusals.py measures before/after."""
+bootstrap refits what a solver once failed on rather than counting it flat; weights
+count as rounds. The data sets main@86344fb refused depending on the row order are in
+tests/data (with how they were found); benchmarks/v50_refusals.py measures before/after.
+"""
 
 from __future__ import annotations
 
@@ -186,19 +187,49 @@ def test_the_fallback_solver_takes_over_where_newton_stops_short(monkeypatch):
     assert "\n" not in str(caught.value) and str(caught.value).startswith("s.csv at 0 deg: ")
 
 
+def test_shots_are_counted_as_rounds_and_rows():
+    """53 rounds in 13 rows: shots and rounds 53, rows 13, perforations the perforating
+    rounds; the same shots one row each give the same fit with rows = rounds = 53."""
+    speed, perforated, weight = from_file("v50_weighted_13_rows.csv")
+    fit = fit_v50(speed, perforated, weight, bootstrap=0)
+    assert (fit.shots, fit.rounds, fit.rows) == (53, 53, 13)
+    assert fit.perforations == int(weight[perforated].sum()) == 25
+    repeats = weight.astype(int)
+    expanded = fit_v50(np.repeat(speed, repeats), np.repeat(perforated, repeats), bootstrap=0)
+    assert (expanded.shots, expanded.rounds, expanded.rows, expanded.perforations) == (
+        53, 53, 53, 25
+    )  # fmt: skip
+    assert expanded.v50_m_s == pytest.approx(fit.v50_m_s, rel=1e-12)
+    fractional = fit_v50(speed, perforated, weight / 4, bootstrap=0)
+    assert (fractional.rounds, fractional.rows) == (13.25, 13)
+
+
+def test_three_weighted_rows_that_overlap_both_ways_are_fitted():
+    """Three rows, 11 rounds: a perforation at 480 m/s below 5 non-perforations at 500
+    m/s, below 5 perforations at 520 m/s. The outcomes overlap both ways, so the
+    likelihood has a maximum: fitted (the GLM's), where main refused "3 shots" (rows)."""
+    speed, perforated, weight = [480.0, 500.0, 520.0], [True, False, True], [1.0, 5.0, 5.0]
+    for method in METHODS:
+        fit = fit_v50(speed, perforated, weight, method=method, bootstrap=0)
+        expected = glm(np.array(speed), np.array(perforated), np.array(weight), method)[0]
+        np.testing.assert_allclose([fit.v50_m_s, fit.sigma_m_s], expected, rtol=TOLERANCE)
+        assert (fit.rounds, fit.rows) == (11, 3)
+
+
 @pytest.mark.parametrize(
     ("speed", "perforated", "weight", "words"),
     [
         ([480.0, 500.0, 520.0], [0, 1, 0], [1.0, 1.0, 1.0], "too few shots for a V50 fit: 3 shots"),
+        ([480.0, 500.0, 520.0, 540.0], [0, 1, 0, 1], [0.5] * 4, r"2 shots \(in 4 rows\)"),
         ([480.0, 490.0, 510.0, 520.0], [1, 1, 0, 0], [2.0] * 4, "show no ballistic limit"),
         ([480.0, 500.0, 500.0, 520.0], [1, 1, 0, 0], [1.0] * 4, "show no ballistic limit"),
     ],
 )
-def test_too_few_shots_and_falling_separation_are_refused_in_one_line(
+def test_too_few_rounds_and_falling_separation_are_refused_in_one_line(
     speed, perforated, weight, words
 ):
-    """Too few shots, and perforations all at or below the non-perforations (the
-    likelihood's maximum is a falling step: no ballistic limit)."""
+    """Too few rounds (weights counted), and perforations all at or below the
+    non-perforations (the likelihood's maximum is a falling step: no ballistic limit)."""
     with pytest.raises(V50Error, match=words) as caught:
         fit_v50(speed, perforated, weight, label="s.csv at 0 deg")
     assert "\n" not in str(caught.value) and str(caught.value).startswith("s.csv at 0 deg: ")

@@ -266,9 +266,11 @@ def _text(row: dict[str, Any]) -> str:
         ]
     else:
         resamples = row["bootstrap_resamples"]
+        # shots are rounds (weights counted); the rows too when a row stands for several
+        rows = f" ({row['rows']} rows)" if row["rows"] != row["rounds"] else ""
         lines = [
-            f"{where}: {row['shots']} shots, {row['perforations']} perforated; {row['method']} "
-            f"fit, {100 * row['confidence']:g}% intervals: profile likelihood"
+            f"{where}: {row['rounds']:g} shots{rows}, {row['perforations']:g} perforated; "
+            f"{row['method']} fit, {100 * row['confidence']:g}% intervals: profile likelihood"
             + (f" | bootstrap ({resamples} resamples)" if resamples else "")
         ]
         for name, key in (("V50", "v50"), ("sigma", "sigma"), ("V10", "v10"), ("V90", "v90")):

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .bootstrap import bootstrap_intervals
-from .likelihood import PROBIT, check_arrays, check_shots, increasing, link_of, prepared
+from .likelihood import PROBIT, check_arrays, check_shots, increasing, link_of, prepared, rounds
 from .profile import Interval, profile_intervals
 from .solver import maximum
 
@@ -40,9 +40,11 @@ class V50Fit:
     rise of perforation with speed, and ``bootstrap_failed`` no fit any solver converged
     on (left out; none is known) (plateimpact.v50.bootstrap). An interval end is
     None where the data do not bound it (for a speed: above 0 m/s). ``mixed_zone_m_s`` is
-    [the slowest perforation, the fastest non-perforation]. ``fit_v50`` raises rather
-    than return a fit that did not converge, so ``converged`` is True on every fit it
-    returns.
+    [the slowest perforation, the fastest non-perforation]. ``rounds`` (also ``shots``)
+    counts the shots with their weights (a row of weight w is w shots), ``perforations``
+    the perforating ones; ``rows`` the rows of positive weight. ``fit_v50`` raises
+    rather than return a fit that did not converge, so ``converged`` is True on every fit
+    it returns.
     """
 
     method: str
@@ -64,8 +66,10 @@ class V50Fit:
     bootstrap_separated: int
     bootstrap_flat: int
     bootstrap_failed: int
-    shots: int
-    perforations: int
+    shots: int | float
+    perforations: int | float
+    rounds: int | float
+    rows: int
     mixed_zone_m_s: tuple[float, float]
     log_likelihood: float
     iterations: int
@@ -123,10 +127,10 @@ def fit_v50(
     are taken in one order (by speed, outcome, weight), so the fit and its bootstrap do
     not depend on the order given.
 
-    Raises :class:`~plateimpact.errors.V50Error` (one line) for fewer than 4 shots, only
-    one outcome, outcomes separated by a speed (the likelihood has no maximum), or a fit
-    that finds perforation less likely at higher speeds (a fit that does not converge
-    would be refused too: none is known);
+    Raises :class:`~plateimpact.errors.V50Error` (one line) for fewer than 4 shots
+    (weights counted), only one outcome, outcomes separated by a speed (the likelihood
+    has no maximum), or a fit that finds perforation less likely at higher speeds (a
+    fit that does not converge would be refused too: none is known);
     :class:`~plateimpact.errors.ParameterError` for bad arguments.
     """
     link = link_of(method)
@@ -146,6 +150,7 @@ def fit_v50(
         v, y, w, link, (point["v50"], scale), bootstrap, rng, confidence, LEVELS
     )
     used = w > 0
+    count = rounds(w[used])
     return V50Fit(
         method=link.name,
         v50_m_s=point["v50"],
@@ -166,8 +171,10 @@ def fit_v50(
         bootstrap_separated=resampled.separated,
         bootstrap_flat=resampled.flat,
         bootstrap_failed=resampled.failed,
-        shots=int(used.sum()),
-        perforations=int((used & y).sum()),
+        shots=count,
+        perforations=rounds(w[used & y]),
+        rounds=count,
+        rows=int(used.sum()),
         mixed_zone_m_s=(float(v[used & y].min()), float(v[used & ~y].max())),
         log_likelihood=-best.negative_log_likelihood,
         iterations=best.iterations,

@@ -33,7 +33,8 @@ from ..errors import ParameterError, V50Error
 #: The fits, by name.
 PROBIT, LOGIT = "probit", "logit"
 METHODS = (PROBIT, LOGIT)
-#: Fewest shots (of positive weight) a fit takes: two parameters and something left over.
+#: Fewest shots (rounds: weights counted) a fit takes: two parameters and something left
+#: over.
 MIN_SHOTS = 4
 
 
@@ -141,21 +142,30 @@ def check_arrays(
         raise ParameterError("impact_speed", "impact speeds must be finite and > 0 m/s")
     if not np.isin(y, (0, 1)).all():
         raise ParameterError("perforated", "perforated must be true/false (1/0) per shot")
-    if not np.all(np.isfinite(w) & (w >= 0)):
-        raise ParameterError("weight", "weights must be finite and >= 0")
+    if not (np.all(np.isfinite(w) & (w >= 0)) and math.isfinite(float(w.sum()))):
+        raise ParameterError("weight", "weights must be finite and >= 0, their sum finite")
     return v, y.astype(bool), w
+
+
+def rounds(weight: np.ndarray) -> int | float:
+    """How many shots the weights stand for (their sum): a whole number when they are."""
+    total = float(weight.sum())
+    return int(total) if total.is_integer() else total
 
 
 def check_shots(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray, label: str) -> None:
     """Refuse shots no fit can take: too few, one outcome, or outcomes separated by a speed
-    (the likelihood then has no maximum)."""
+    (the likelihood then has no maximum). Shots are counted as rounds: a row of weight w
+    is w shots."""
     used = weight > 0
-    count, go = int(used.sum()), int((used & perforated).sum())
-    if count < MIN_SHOTS or go == 0 or go == count:
+    count, go = rounds(weight[used]), rounds(weight[used & perforated])
+    rows, go_rows = int(used.sum()), int((used & perforated).sum())
+    if count < MIN_SHOTS or go_rows == 0 or go_rows == rows:
+        in_rows = f" (in {rows} rows)" if rows != count else ""
         raise V50Error(
-            f"{label}: too few shots for a V50 fit: {count} shots, {go} perforations and "
-            f"{count - go} non-perforations; a fit needs at least {MIN_SHOTS} shots with "
-            "both outcomes"
+            f"{label}: too few shots for a V50 fit: {count:g} shots{in_rows}, {go:g} "
+            f"perforations and {count - go:g} non-perforations; a fit needs at least "
+            f"{MIN_SHOTS} shots with both outcomes"
         )
     go_speeds, no_go_speeds = speed[used & perforated], speed[used & ~perforated]
     highest_no_go, lowest_go = float(no_go_speeds.max()), float(go_speeds.min())
