@@ -204,6 +204,8 @@ def test_shots_no_fit_can_take_are_refused_in_one_line(speed, perforated, words)
         ({"bootstrap": -1}, "bootstrap"),
         ({"bootstrap": 2.5}, "bootstrap"),
         ({"weight": [1, 1, -1, 1, 1]}, "weight"),
+        ({"weight": [1, 1, 2e9, 1, 1]}, "weight"),  # more shots than a row can stand for
+        ({"weight": [1, 1, math.nan, 1, 1]}, "weight"),
     ],
 )
 def test_bad_options_are_parameter_errors(options, parameter):

@@ -203,6 +203,17 @@ def test_weighted_rows_are_counted_as_rounds_and_the_file_main_refused_is_fitted
     )
 
 
+def test_a_weight_beyond_a_billion_is_one_line_and_exit_2(tmp_path, capsys):
+    """Weights of 1e300 overflowed the bootstrap's counts (an internal error, a traceback
+    file) and the sums; refused in one line with the range."""
+    path = tmp_path / "huge.csv"
+    rows = "".join(f"{v},0,{p},1e300\n" for v, p in ((480, 0), (500, 1), (510, 0), (520, 1)))
+    path.write_text(f"{HEADER},weight\n{rows}")
+    assert main(["v50", str(path), "--bootstrap", "10"]) == 2
+    err = capsys.readouterr().err
+    assert err == "plateimpact: error: weights must be in [0, 1e+09] (the shots a row stands for)\n"
+
+
 def test_resamples_no_fit_converged_on_are_reported(capsys, monkeypatch):
     """Every resample's fit made to fail: the text counts them failed, left out; the
     bootstrap intervals are '-' (none), the JSON's bootstrap_failed the resamples."""

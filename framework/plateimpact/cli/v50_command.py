@@ -19,6 +19,7 @@ from ..registry import PluginRegistry
 from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP
+from ..v50.likelihood import shown as count_shown
 from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
@@ -269,8 +270,9 @@ def _text(row: dict[str, Any]) -> str:
         # shots are rounds (weights counted); the rows too when a row stands for several
         rows = f" ({row['rows']} rows)" if row["rows"] != row["rounds"] else ""
         lines = [
-            f"{where}: {row['rounds']:g} shots{rows}, {row['perforations']:g} perforated; "
-            f"{row['method']} fit, {100 * row['confidence']:g}% intervals: profile likelihood"
+            f"{where}: {count_shown(row['rounds'])} shots{rows}, "
+            f"{count_shown(row['perforations'])} perforated; {row['method']} fit, "
+            f"{100 * row['confidence']:g}% intervals: profile likelihood"
             + (f" | bootstrap ({resamples} resamples)" if resamples else "")
         ]
         for name, key in (("V50", "v50"), ("sigma", "sigma"), ("V10", "v10"), ("V90", "v90")):

@@ -36,6 +36,9 @@ METHODS = (PROBIT, LOGIT)
 #: Fewest shots (rounds: weights counted) a fit takes: two parameters and something left
 #: over.
 MIN_SHOTS = 4
+#: The largest weight a row takes (a billion shots): beyond it the sums that the fit and
+#: its intervals work with lose their meaning, and the bootstrap's counts their type.
+MAX_WEIGHT = 1e9
 
 
 @attrs.frozen
@@ -142,8 +145,10 @@ def check_arrays(
         raise ParameterError("impact_speed", "impact speeds must be finite and > 0 m/s")
     if not np.isin(y, (0, 1)).all():
         raise ParameterError("perforated", "perforated must be true/false (1/0) per shot")
-    if not (np.all(np.isfinite(w) & (w >= 0)) and math.isfinite(float(w.sum()))):
-        raise ParameterError("weight", "weights must be finite and >= 0, their sum finite")
+    if not np.all((w >= 0) & (w <= MAX_WEIGHT)):  # NaN fails too
+        raise ParameterError(
+            "weight", f"weights must be in [0, {MAX_WEIGHT:g}] (the shots a row stands for)"
+        )
     return v, y.astype(bool), w
 
 
@@ -153,19 +158,25 @@ def rounds(weight: np.ndarray) -> int | float:
     return int(total) if total.is_integer() else total
 
 
+def shown(count: int | float) -> str:
+    """A count of shots for people: whole numbers in full, others to 6 digits."""
+    return str(count) if isinstance(count, int) else f"{count:.6g}"
+
+
 def check_shots(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray, label: str) -> None:
     """Refuse shots no fit can take: too few, one outcome, or outcomes separated by a speed
     (the likelihood then has no maximum). Shots are counted as rounds: a row of weight w
     is w shots."""
     used = weight > 0
     count, go = rounds(weight[used]), rounds(weight[used & perforated])
+    no_go = rounds(weight[used & ~perforated])
     rows, go_rows = int(used.sum()), int((used & perforated).sum())
     if count < MIN_SHOTS or go_rows == 0 or go_rows == rows:
         in_rows = f" (in {rows} rows)" if rows != count else ""
         raise V50Error(
-            f"{label}: too few shots for a V50 fit: {count:g} shots{in_rows}, {go:g} "
-            f"perforations and {count - go:g} non-perforations; a fit needs at least "
-            f"{MIN_SHOTS} shots with both outcomes"
+            f"{label}: too few shots for a V50 fit: {shown(count)} shots{in_rows}, "
+            f"{shown(go)} perforations and {shown(no_go)} non-perforations; a fit needs at "
+            f"least {MIN_SHOTS} shots with both outcomes"
         )
     go_speeds, no_go_speeds = speed[used & perforated], speed[used & ~perforated]
     highest_no_go, lowest_go = float(no_go_speeds.max()), float(go_speeds.min())
