@@ -39,8 +39,8 @@ EIGENVALUE_FLOOR = 1e-12
 Problem = Callable[[np.ndarray], tuple[float, np.ndarray, np.ndarray]]
 
 
-def _problem(shots: GoNoGo, link: Link) -> tuple[Problem, np.ndarray]:
-    """−log L, its gradient and Hessian at β, and the design matrix [1, x]."""
+def _problem(shots: GoNoGo, link: Link) -> Problem:
+    """−log L, its gradient and Hessian at β."""
     design = np.column_stack([np.ones_like(shots.x), shots.x])
 
     def at(beta: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
@@ -49,7 +49,7 @@ def _problem(shots: GoNoGo, link: Link) -> tuple[Problem, np.ndarray]:
         value = shots.negative_log_likelihood(eta, link)
         return value, design.T @ first, (design.T * second) @ design
 
-    return at, design
+    return at
 
 
 def flat_start(shots: GoNoGo, link: Link) -> np.ndarray:
@@ -112,7 +112,7 @@ def maximum(shots: GoNoGo, link: Link, label: str) -> Estimate:
     trust-region solver from where Newton stopped if that is not a maximum. V50Error
     (one line) if neither reaches a gradient within the tolerance, which the shots
     check_shots lets through do not make happen (their likelihood has a maximum)."""
-    problem, _ = _problem(shots, link)
+    problem = _problem(shots, link)
     tolerance = GRADIENT_TOLERANCE * float(shots.weight.sum())
 
     def converged(beta: np.ndarray) -> bool:
