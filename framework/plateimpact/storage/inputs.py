@@ -7,7 +7,8 @@
      "model": {"resistance": "poncelet", "resistance_version": "1.0",
                "resistance_settings": {}, "failure": ..., "integrator": "dopri5",
                "integrator_settings": {"rtol": 1e-08, ...}, "rest_speed_fraction": 0.01},
-     "versions": {"python": ..., "plateimpact": ..., ...}, "source_commit": "..."}
+     "versions": {"python": ..., "plateimpact": ..., ...}, "source_commit": "...",
+     "plugins": {"core": {...}, "resistance": {...}, ...}}  (storage.code_provenance)
 
 Every number is in the unit its key names (``_mm``, ``_g``, ``_deg``; a setting's key is
 its declaration's :attr:`~plateimpact.Parameter.key`), written as the shortest number
