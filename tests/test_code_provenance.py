@@ -15,6 +15,7 @@ import importlib.util
 import json
 import shutil
 import sys
+import types
 from pathlib import Path
 
 import attrs
@@ -377,3 +378,26 @@ def test_a_plain_run_computes_no_record(monkeypatch, capsys):
     assert main(argv) == 0 and asked == []
     assert main([*argv, "--json"]) == 0 and len(asked) == 1
     capsys.readouterr()
+
+
+def test_a_plug_in_of_a_script_is_hashed_by_its_file_and_one_of_no_file_is_unknown(
+    tmp_path, monkeypatch
+):
+    """A study script's own plug-in (its module ``__main__``, which has no spec) is its
+    file; a class made by ``exec`` has none, and its code is unknown, not guessed."""
+    script = tmp_path / "study.py"
+    script.write_text("import numpy\n")
+    for name, file in (("script_main", str(script)), ("made_by_exec", None)):
+        module = types.ModuleType(name)
+        module.__file__ = file
+        monkeypatch.setitem(sys.modules, name, module)
+    law = type("Law", (pi.ResistanceLaw,), {"name": "law", "__module__": "script_main"})
+    assert code_provenance.plugin_record(law)["source_sha256"] == sha256_of_modules(
+        {"script_main": script}
+    )
+    made = type("Made", (pi.ResistanceLaw,), {"name": "made", "__module__": "made_by_exec"})
+    assert code_provenance.plugin_record(made)["source_sha256"] is None
+    same = {"resistance": code_provenance.plugin_record(made)}  # recorded and now alike,
+    assert code_provenance.changes(same, same) == [  # and still not known to be the same
+        "resistance made: source unknown (recorded none, now none)"
+    ]

@@ -68,11 +68,13 @@ def source_sha256(sources: Iterable[tuple[str, Path | None]]) -> str | None:
 
 def _origin(name: str) -> Path | None:
     """The file module ``name`` is (or would be) loaded from, found without importing
-    anything: its spec if loaded, else the finders', below its parent's search path."""
+    anything: its spec if loaded, else the finders', below its parent's search path; a
+    script run as ``__main__`` has no spec, but its file."""
     spec = _spec(name)
-    if spec is None or not spec.has_location or not spec.origin:
-        return None
-    return Path(spec.origin)
+    if spec is not None and spec.has_location and spec.origin:
+        return Path(spec.origin)
+    where = getattr(sys.modules.get(name), "__file__", None)
+    return Path(where) if isinstance(where, str) else None
 
 
 def _spec(name: str) -> ModuleSpec | None:
