@@ -31,7 +31,16 @@ from .stored_limits import compare_stored, kinds, show_stored
 
 def add_parsers(sub: Any) -> None:
     p = sub.add_parser("reproduce", help="run the report's figure families into one archive")
-    p.add_argument("--out", default="report", help="output directory, created (default: report)")
+    p.add_argument(
+        "--out",
+        help="output directory, created (default: report, with --quick report-quick)",
+    )
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="a smoke test of the whole job in a few seconds: every study, variant, "
+        "stored map and experiment tool, through the same code, on a few scenes each",
+    )
     rerun = p.add_mutually_exclusive_group()
     rerun.add_argument(
         "--resume",
@@ -151,6 +160,8 @@ def reproduce_command(args: argparse.Namespace) -> None:
     from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
 
     reproduce = study_collection("report")
+    if args.out is None:  # a quick archive holds other scenes: never the full one's place
+        args.out = "report-quick" if args.quick else "report"
     out = Path(args.out)
     if not str(args.out).strip():
         raise UsageError("--out: give a directory name")
@@ -161,9 +172,12 @@ def reproduce_command(args: argparse.Namespace) -> None:
     if args.tag is not None and not _printable_tag(args.tag):
         raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
     try:
+        # quick only when asked: a collection of an older signature still runs in full
+        quick = {"quick": True} if args.quick else {}
         archive, figures = reproduce(
-            out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format
-        )
+            out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format,
+            **quick,
+        )  # fmt: skip
     except StaleRunError as exc:  # neither kept nor replaced unasked: say how to proceed
         raise UsageError(
             f"{exc.what}; --overwrite replaces it, --as TAG stores the new runs as "
