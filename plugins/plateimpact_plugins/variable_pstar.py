@@ -123,8 +123,9 @@ class PstarTable:
         return cls.from_rows([(0.0, pstar * 1e3, pstar * 1e3, 0.0, 0.0)])
 
     def as_setting(self) -> list[list[float]]:
-        """The table as a JSON value (its rows), for study variants and archives."""
-        return [list(row) for row in self.rows()]
+        """The table as a JSON value (its rows, plain floats), for study variants and
+        archives."""
+        return [[float(x) for x in row] for row in self.rows()]
 
     def rows(self) -> list[tuple[float, ...]]:
         """The table in user units, as :meth:`from_rows` takes it."""
@@ -181,6 +182,20 @@ def _to_table(value: object) -> PstarTable:
     )
 
 
+def _table_json(value: object) -> object:
+    """The table as a JSON value: its rows. What an archive gives back is already rows
+    (plain lists): checked as rows and kept as they are, so a setting read back describes
+    itself exactly as the table did (converting them through SI again could move the
+    last digit). A CSV path stays the path it is."""
+    if isinstance(value, PstarTable):
+        return value.as_setting()
+    if isinstance(value, str | os.PathLike):
+        return os.fspath(value)
+    _to_table(value)  # a ParameterError for what no table is made of
+    rows: Sequence[Sequence[float]] = value if isinstance(value, Sequence) else ()
+    return [[float(x) for x in row] for row in rows]
+
+
 PSTAR_TABLE = Parameter(
     "table",
     "P* by impact obliquity and speed: a PstarTable, its rows, or a CSV file with columns "
@@ -189,7 +204,7 @@ PSTAR_TABLE = Parameter(
     default=None,
     flag="--pstar-table",
     convert=lambda value: _to_table(SAE1010_TABLE if value is None else value),
-    to_json=lambda table: [list(row) for row in table.rows()],
+    to_json=_table_json,
 )
 
 
