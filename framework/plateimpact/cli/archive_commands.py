@@ -23,7 +23,7 @@ from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
-from .common import UsageError, add_dpi_option, check_directory
+from .common import UsageError, add_dpi_option, check_directory, say
 from .describe import run_lines, scene_line
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
@@ -188,9 +188,9 @@ def reproduce_command(args: argparse.Namespace) -> None:
             f"{str(exc).split(':', 1)[0]}: --resume keeps it (runs only what is missing), "
             "--overwrite replaces it, --as TAG stores the new runs as VARIANT@TAG"
         ) from None
-    print(f"archive: {archive}")
+    say(f"archive: {archive}")
     for figure in figures:
-        print(f"figure:  {figure}")
+        say(f"figure:  {figure}")
 
 
 def _printable_tag(tag: str) -> bool:
@@ -215,14 +215,14 @@ def show_command(args: argparse.Namespace) -> None:
         meta: dict[str, Any] = archive.metadata(name)
         result: BatchResult = archive.results(name)
         counts = np.bincount(result.outcome, minlength=4)[1:]
-        print(f"{name}")
+        say(f"{name}")
         for line in run_lines(meta):
-            print(line)
+            say(line)
         for line in code_lines(meta.get("plugins")):  # each plug-in's origin and source hash
-            print(f"  {line}")
+            say(f"  {line}")
         study = archive.study(name.split("/", 1)[0])
-        print(scene_line(study.scenes, study.plate_labels))
-        print(
+        say(scene_line(study.scenes, study.plate_labels))
+        say(
             f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
             f"{counts[2]} perforation; wall {meta['wall_time_s']:.2f} s"
         )
@@ -232,10 +232,10 @@ def show_command(args: argparse.Namespace) -> None:
             if data is not None
         ]
         if kept:
-            print(f"  with {' and '.join(kept)}")
-        print(f"  run {meta['start_time']} on {meta['host']}")
+            say(f"  with {' and '.join(kept)}")
+        say(f"  run {meta['start_time']} on {meta['host']}")
         data = archive.data_file(name)  # format 2: the run's own netCDF file
-        print(f"  data {data}" if data is not None else "  data in the archive (format 1)")
+        say(f"  data {data}" if data is not None else "  data in the archive (format 1)")
     show_stored(archive)
 
 
@@ -264,7 +264,7 @@ def compare_command(args: argparse.Namespace) -> None:
 
         plotting.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
         if not args.json:
-            print(f"figure: {args.png}")
+            say(f"figure: {args.png}")
 
 
 def plot_command(args: argparse.Namespace) -> None:
@@ -288,4 +288,4 @@ def plot_command(args: argparse.Namespace) -> None:
         stages.update()
         plotting.save(figure, args.out, "--out", dpi=args.dpi)
         stages.update()
-    print(f"figure: {args.out}")
+    say(f"figure: {args.out}")

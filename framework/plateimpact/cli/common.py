@@ -1,17 +1,23 @@
-"""What every command shares: the one-line error, output files written atomically."""
+"""What every command shares: the one-line error, output files written atomically, and
+the one writer of standard output (:func:`say`, :func:`write_stdout`): a full or closed
+standard output is one line and exit code 2, never a traceback or Python's "Exception
+ignored" at exit."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import io
 import math
+import os
 import sys
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
 from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, OutputError, check_output, write_text
+from ..storage.untrusted import printable
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -29,7 +35,15 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
-        self.exit(2, f"plateimpact: error: {message}\n")
+        self.exit(2, f"plateimpact: error: {printable(message)}\n")
+
+    def _print_message(self, message: str, file: Any = None) -> None:
+        # --help and --version go through the one writer: argparse's own swallows a
+        # failed write (and Python reports it at exit)
+        if message and (file is None or file is sys.stdout):
+            write_stdout(message)
+        else:
+            super()._print_message(message, file)
 
 
 def check_directory(path: str | None, flag: str, kind: str = "csv") -> None:
@@ -81,15 +95,74 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
+class StdoutError(OutputError):
+    """Standard output cannot take what a command prints: a full device, a closed one."""
+
+
+def stdout_closed() -> bool:
+    """Whether the command was started with standard output closed (``>&-``): Python then
+    has no ``sys.stdout``, and the next file opened would take its descriptor."""
+    if sys.stdout is None:
+        return True
+    try:
+        descriptor = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a file: a caller's buffer
+        return False
+    try:
+        os.fstat(descriptor)
+    except OSError:
+        return True
+    return False
+
+
 def write_stdout(text: str) -> None:
-    """Print ``text``; a standard output that cannot take it (a full device) is one line."""
+    """Print ``text`` as it is (CSV, JSON), flushed now: a standard output that cannot
+    take it (a full device, closed) is a one-line :class:`StdoutError`."""
+    if sys.stdout is None:
+        raise StdoutError("standard output is closed; redirect it (e.g. > /dev/null)")
     try:
         sys.stdout.write(text)
         sys.stdout.flush()
     except BrokenPipeError:
         raise
     except OSError as exc:
-        raise OutputError(f"standard output: cannot write: {exc.strerror}") from None
+        reason = exc.strerror or type(exc).__name__
+        raise StdoutError(f"standard output: cannot write: {reason}") from None
+
+
+def flush_stdout() -> None:
+    """Flush standard output (what a library printed past :func:`write_stdout`); a
+    failure is a one-line :class:`StdoutError`."""
+    if sys.stdout is None:
+        return
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise StdoutError(f"standard output: cannot write: {reason}") from None
+
+
+def say(text: object = "") -> None:
+    """Print one or more lines of human-readable text (and a new line): every character a
+    terminal would act on is escaped line by line (untrusted.printable), so that text
+    from a file that reached it unescaped still prints inert; then :func:`write_stdout`."""
+    lines = str(text).split("\n")
+    write_stdout("\n".join(printable(line) for line in lines) + "\n")
+
+
+def discard_stdout() -> None:
+    """After standard output failed: point its descriptor at /dev/null, so that what is
+    still buffered does not fail again at exit (Python's "Exception ignored" and exit
+    code 120). Only for a real file descriptor (not a caller's buffer)."""
+    with contextlib.suppress(AttributeError, OSError, ValueError):
+        descriptor = sys.stdout.fileno()
+        null = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(null, descriptor)
+        finally:
+            os.close(null)
 
 
 def csv_text(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:

@@ -22,6 +22,7 @@ from .common import (
     check_directory,
     csv_text,
     save_figure_atomically,
+    say,
     write_atomically,
 )
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
@@ -115,7 +116,7 @@ def _writable_archive(args: argparse.Namespace) -> Archive | None:
 def _store(archive: Archive | None, name: str, found: lim.Limits | lim.OutcomeMap) -> None:
     if archive is not None:
         stored = lim.archive_limits(archive, name.replace("/", "_"), found)
-        print(f"archive: {archive.path} (limits/{stored})")
+        say(f"archive: {archive.path} (limits/{stored})")
 
 
 def _number(text: str, flag: str) -> float:
@@ -209,7 +210,7 @@ def limits_command(args: argparse.Namespace) -> None:
 
         save_figure_atomically(plot_bands(found, label), args.png, dpi=args.dpi)
     if args.json:
-        print(json.dumps({"preset": label, **found.to_json()}))
+        say(json.dumps({"preset": label, **found.to_json()}))
     else:
         _print(found, label, args.outcome)
     _store(archive, args.name or f"{label}_{simulation.model.failure.name}", found)
@@ -249,8 +250,8 @@ def _print(found: lim.Limits, label: str, outcomes: list[str] | None) -> None:
         else:
             where = f"{line.fixed:g} m/s"
             named = f"critical ricochet obliquity {show(line.critical_ricochet_obliquity)}"
-        print(f"{label} at {where}: {' | '.join(bands) or 'no such band'} {unit}; {named}")
-    print(
+        say(f"{label} at {where}: {' | '.join(bands) or 'no such band'} {unit}; {named}")
+    say(
         f"boundaries bracketed to {found.tolerance / scale:g} {unit}, no band of "
         f"{found.resolution / scale:g} {unit} missed; {found.scenes:,} scenes in "
         f"{found.seconds:.1f} s ({found.model['integrator']})"
@@ -289,7 +290,7 @@ def map_command(args: argparse.Namespace) -> None:
                                  span, samples, rows, tolerance=tolerance)  # fmt: skip
     maps = [(label, one) for (_, _, label), one in zip(plates, found, strict=True)]
     shape, counted = found[0].shape, found[0].limits
-    print(
+    say(
         f"{', '.join(label for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
         f"{shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
     )
@@ -297,7 +298,7 @@ def map_command(args: argparse.Namespace) -> None:
 
     draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves
     save_figure_atomically(draw(maps), args.png, dpi=args.dpi)
-    print(f"figure:  {args.png}")
+    say(f"figure:  {args.png}")
     failure = simulation.model.failure.name
     for label, drawn in maps:
         name = f"map_{label}_{failure}"

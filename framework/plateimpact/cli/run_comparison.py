@@ -8,6 +8,7 @@ import numpy as np
 
 from ..comparison import Comparison, ComparisonRow, OutcomeRange, Spread
 from ..limits.lines import SPEED
+from .common import say
 
 
 def _place(axis: str, start: float, end: float) -> str:
@@ -93,6 +94,6 @@ def print_comparison(comparison: Comparison, *, as_json: bool, summary: bool) ->
     if as_json:
         runs = {"a": comparison.run_a, "b": comparison.run_b}
         found = {**runs, **comparison.summary()} if summary else comparison.to_json()
-        print(json.dumps(found, indent=2))
+        say(json.dumps(found, indent=2))
     else:
-        print(summary_text(comparison) if summary else text(comparison))
+        say(summary_text(comparison) if summary else text(comparison))

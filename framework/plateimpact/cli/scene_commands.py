@@ -25,6 +25,7 @@ from .common import (
     check_directory,
     csv_text,
     save_figure_atomically,
+    say,
     write_atomically,
     write_stdout,
 )
@@ -162,20 +163,20 @@ def run_command(args: argparse.Namespace) -> None:
             label=label,
             scene={IMPACT_SPEED: scene.impact_speed, IMPACT_OBLIQUITY: scene.impact_obliquity},
         )
-        print(json.dumps(out))
+        say(json.dumps(out))
         return
-    print(f"{label}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
-    print(f"  exit speed       {result.exit_speed:.6g} m/s")
-    print(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
-    print(f"  contact time     {result.contact_time * 1e6:.6g} us")
-    print(f"  max penetration  {result.max_penetration * 1e3:.6g} mm")
+    say(f"{label}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
+    say(f"  exit speed       {result.exit_speed:.6g} m/s")
+    say(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
+    say(f"  contact time     {result.contact_time * 1e6:.6g} us")
+    say(f"  max penetration  {result.max_penetration * 1e3:.6g} mm")
     if result.plate_failed:
-        print(
+        say(
             f"  plate failed     at P = {result.failure_penetration * 1e3:.6g} mm, "
             f"Y = {result.failure_lateral * 1e3:.6g} mm, t = {result.failure_time * 1e6:.6g} us"
         )
     else:
-        print("  plate failed     no")
+        say("  plate failed     no")
 
 
 def crater_command(args: argparse.Namespace) -> None:
@@ -187,7 +188,7 @@ def crater_command(args: argparse.Namespace) -> None:
     section = crater_section(
         result.trajectory, scene.sphere.radius, thickness=scene.plate.thickness
     )
-    print(
+    say(
         f"{label}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
         f"{result.outcome.label}; crater {section.length * 1e3:.4g} mm long, "
         f"{section.max_depth * 1e3:.4g} mm deep"
@@ -251,7 +252,7 @@ def write_sweep_inputs(
         obliquities_deg=args.obliquities,
     )
     write_atomically(sidecar(args.csv), json.dumps(record, indent=2) + "\n", "--csv")
-    print(f"inputs and provenance: {sidecar(args.csv)}")
+    say(f"inputs and provenance: {sidecar(args.csv)}")
 
 
 def _check_sweep_size(speeds: int, obliquities: int, force: bool) -> None:
@@ -281,7 +282,7 @@ def sweep_command(args: argparse.Namespace) -> None:
                 write_stdout(text)
             return
         stream_text(args.csv, texts, "--csv")
-    print(
+    say(
         f"wrote {sweep.size} scenes to {args.csv}: "
         + ", ".join(f"{sweep.counts[o]} {o.label}" for o in Outcome)
     )

@@ -13,7 +13,7 @@ from ..limits.lines import OBLIQUITY, SPEED, LimitLine
 from ..limits.records import KIND_MAP, NAMES, attributes_of
 from ..storage.archive import Archive
 from ..storage.records import LIMITS
-from .common import UsageError
+from .common import UsageError, say
 
 _UNIT = {SPEED: "m/s", OBLIQUITY: "deg"}
 
@@ -81,17 +81,17 @@ def show_stored(archive: Archive) -> None:
         else:
             what = f"limits along {NAMES[axis]}, {len(limits.lines)} line(s)"
         digits = _digits(axis, limits.tolerance)
-        print(f"{LIMITS}/{name}: {what}")
-        print(f"  plate {plate['material']} {plate['thickness_mm']:g} mm ({constants})")
-        print(f"  model: {_model(limits.model)}")
-        print(
+        say(f"{LIMITS}/{name}: {what}")
+        say(f"  plate {plate['material']} {plate['thickness_mm']:g} mm ({constants})")
+        say(f"  model: {_model(limits.model)}")
+        say(
             f"  tolerance {user(axis, limits.tolerance):g} {unit}, resolution "
             f"{user(axis, limits.resolution):g} {unit}; {limits.scenes} scenes, "
             f"{limits.passes} passes, wall {limits.seconds:.2f} s"
         )
         for line in limits.lines:
-            print(f"  {_fixed(axis, line.fixed)}: {_named(axis, line, digits)}")
-        print(
+            say(f"  {_fixed(axis, line.fixed)}: {_named(axis, line, digits)}")
+        say(
             f"  made {meta['creation_time']} on {meta['host']}, plateimpact "
             f"{meta['versions'].get('plateimpact')}, commit {str(meta['git_commit'])[:12]}"
         )
@@ -184,6 +184,6 @@ def compare_stored(archive: Archive, name_a: str, name_b: str, as_json: bool) ->
         )
     comparison = compare_limits(a, b)
     if as_json:
-        print(json.dumps({"a": name_a, "b": name_b, **comparison.to_json()}, indent=2))
+        say(json.dumps({"a": name_a, "b": name_b, **comparison.to_json()}, indent=2))
         return
-    print(_text(name_a, name_b, comparison))
+    say(_text(name_a, name_b, comparison))

@@ -20,7 +20,7 @@ from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP
 from ..v50.likelihood import shown as count_shown
-from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically
+from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically, say
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
 MIL_STD = "mil-std-662f"
@@ -215,12 +215,12 @@ def v50_command(args: argparse.Namespace) -> None:
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     rows = [_json(args, o, r, groups[o].labels, model_limits, model) for o, r in results.items()]
     if args.json:
-        print(json.dumps(rows[0] if len(rows) == 1 else rows))
+        say(json.dumps(rows[0] if len(rows) == 1 else rows))
     else:
         for row in rows:
-            print(_text(row))
+            say(_text(row))
         if args.png is not None:
-            print(f"figure: {args.png}")
+            say(f"figure: {args.png}")
 
 
 def _json(
