@@ -8,8 +8,6 @@ from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..discovery import (
     BrokenPackage,
     distribution_label,
@@ -19,12 +17,11 @@ from ..discovery import (
 )
 from ..errors import PluginError
 from ..progress import progress_bar
-from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
 from .common import UsageError, add_dpi_option, check_directory, say
-from .describe import run_lines, scene_line
+from .describe import run_description
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
 
@@ -208,34 +205,10 @@ def _study_results(archive: Archive, runs: list[str]) -> StudyResults:
 
 
 def show_command(args: argparse.Namespace) -> None:
-    from ..storage.code_provenance import summary as code_lines  # noqa: PLC0415
 
     archive = Archive(args.archive)
     for name in archive.runs():
-        meta: dict[str, Any] = archive.metadata(name)
-        result: BatchResult = archive.results(name)
-        counts = np.bincount(result.outcome, minlength=4)[1:]
-        say(f"{name}")
-        for line in run_lines(meta):
-            say(line)
-        for line in code_lines(meta.get("plugins")):  # each plug-in's origin and source hash
-            say(f"  {line}")
-        study = archive.study(name.split("/", 1)[0])
-        say(scene_line(study.scenes, study.plate_labels))
-        say(
-            f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
-            f"{counts[2]} perforation; wall {meta['wall_time_s']:.2f} s"
-        )
-        kept = [
-            what
-            for what, data in (("trajectories", result.trajectory), ("craters", result.craters))
-            if data is not None
-        ]
-        if kept:
-            say(f"  with {' and '.join(kept)}")
-        say(f"  run {meta['start_time']} on {meta['host']}")
-        data = archive.data_file(name)  # format 2: the run's own netCDF file
-        say(f"  data {data}" if data is not None else "  data in the archive (format 1)")
+        say("\n".join(run_description(archive, name)))
     show_stored(archive)
 
 

@@ -13,6 +13,7 @@ from ..bodies import MASS, RADIUS, THICKNESS
 from ..parameters import Parameter
 from ..registry import KINDS, PluginRegistry, default_registry
 from .common import say
+from .describe import shown
 
 
 def add_parsers(sub: Any) -> None:
@@ -66,7 +67,7 @@ def presets_command(args: argparse.Namespace) -> None:
 def _details(registry: PluginRegistry, kind: str, name: str) -> list[str]:
     cls = registry.get(kind, name)
     summary = (inspect.getdoc(cls) or "").split("\n")[0]
-    lines = [f"  {name} (version {cls.version}, {cls.__module__}): {summary}"]
+    lines = [f"  {shown(name)} (version {shown(cls.version)}, {cls.__module__}): {shown(summary)}"]
     for setting, declared in cls.setting_declarations().items():
         alias = f", or {declared.flag}" if declared.flag else ""
         lines.append(f"      --set {kind}.{setting}=VALUE{alias}: {declared.help()}")
@@ -82,12 +83,12 @@ def _details(registry: PluginRegistry, kind: str, name: str) -> list[str]:
 def plugins_command(args: argparse.Namespace) -> None:
     registry = default_registry()
     for kind in KINDS:
-        say(f"{kind}: {', '.join(registry.names(kind))}")
+        say(f"{kind}: {', '.join(shown(name) for name in registry.names(kind))}")
         if args.details:
             for name in registry.names(kind):
                 say("\n".join(_details(registry, kind, name)))
     for package in registry.broken:  # skipped, none of their plug-ins registered
-        say(f"broken: {package.describe()}")
+        say(f"broken: {shown(package.describe(), None)}")
         if args.details and package.provides:
-            named = ", ".join(f"{kind} {name}" for kind, name in package.provides)
+            named = ", ".join(f"{kind} {shown(name)}" for kind, name in package.provides)
             say(f"  would provide: {named}")

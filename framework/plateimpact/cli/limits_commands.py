@@ -25,6 +25,7 @@ from .common import (
     say,
     write_atomically,
 )
+from .describe import shown
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
 _DEG = math.pi / 180.0
@@ -250,7 +251,8 @@ def _print(found: lim.Limits, label: str, outcomes: list[str] | None) -> None:
         else:
             where = f"{line.fixed:g} m/s"
             named = f"critical ricochet obliquity {show(line.critical_ricochet_obliquity)}"
-        say(f"{label} at {where}: {' | '.join(bands) or 'no such band'} {unit}; {named}")
+        shown_bands = " | ".join(bands) or "no such band"
+        say(f"{shown(label, None)} at {where}: {shown_bands} {unit}; {named}")
     say(
         f"boundaries bracketed to {found.tolerance / scale:g} {unit}, no band of "
         f"{found.resolution / scale:g} {unit} missed; {found.scenes:,} scenes in "
@@ -291,7 +293,7 @@ def map_command(args: argparse.Namespace) -> None:
     maps = [(label, one) for (_, _, label), one in zip(plates, found, strict=True)]
     shape, counted = found[0].shape, found[0].limits
     say(
-        f"{', '.join(label for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
+        f"{', '.join(shown(label, None) for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
         f"{shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
     )
     from ..limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415

@@ -10,6 +10,7 @@ from ..errors import ParameterError
 from ..storage.archive import Archive
 from ..storage.output import write_output
 from .common import UsageError, check_directory, csv_text, say
+from .describe import shown
 
 
 def add_parsers(sub: Any) -> None:
@@ -55,4 +56,4 @@ def export_command(args: argparse.Namespace) -> None:
     else:
         text = csv_text(export.table_header(archive, run), export.table_rows(archive, run))
         write_output(args.to, "--to", lambda handle: handle.write(text.encode()))
-    say(f"wrote {run} to {args.to}")
+    say(f"wrote {shown(run, None)} to {shown(args.to, None)}")

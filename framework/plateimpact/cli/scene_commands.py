@@ -29,6 +29,7 @@ from .common import (
     write_atomically,
     write_stdout,
 )
+from .describe import shown
 from .options import (
     add_body_options,
     add_model_options,
@@ -165,7 +166,7 @@ def run_command(args: argparse.Namespace) -> None:
         )
         say(json.dumps(out))
         return
-    say(f"{label}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
+    say(f"{shown(label, None)}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
     say(f"  exit speed       {result.exit_speed:.6g} m/s")
     say(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
     say(f"  contact time     {result.contact_time * 1e6:.6g} us")
@@ -189,7 +190,7 @@ def crater_command(args: argparse.Namespace) -> None:
         result.trajectory, scene.sphere.radius, thickness=scene.plate.thickness
     )
     say(
-        f"{label}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
+        f"{shown(label, None)}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
         f"{result.outcome.label}; crater {section.length * 1e3:.4g} mm long, "
         f"{section.max_depth * 1e3:.4g} mm deep"
     )

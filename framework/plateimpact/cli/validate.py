@@ -14,6 +14,7 @@ from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..storage.shots import Shots
 from .common import add_dpi_option, check_directory, save_figure_atomically, say
+from .describe import shown
 from .options import add_body_options, add_model_options, bodies, model_choice
 
 #: Disagreeing shots listed in the text output (--json lists all).
@@ -83,10 +84,10 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
     go_no_go = int((shots.outcome == 0).sum())
     angles = ", ".join(f"{math.degrees(o):.6g}" for o in shots.groups_by_obliquity())
     say(
-        f"{label}: {len(shots)} shots from {args.shots}"
+        f"{shown(label, None)}: {len(shots)} shots from {shown(args.shots, None)}"
         + (f" ({go_no_go} go/no-go)" if go_no_go else "")
-        + f" at {angles} deg; model {model['resistance']} + {model['failure']} "
-        f"({model['integrator']})"
+        + f" at {angles} deg; model {shown(model['resistance'])} + {shown(model['failure'])} "
+        f"({shown(model['integrator'])})"
     )
     say(f"outcome agreement {100 * report.agreement:.1f}% (weighted)")
     width = max(len(name) for name in MEASURED) + 2
@@ -119,8 +120,8 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
         line = d.label.removeprefix(f"{args.shots} ")  # the file is named above
         angle = math.degrees(d.impact_obliquity)
         say(
-            f"  {line}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured {d.measured}, "
-            f"model {d.predicted}; {where}"
+            f"  {shown(line, None)}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured "
+            f"{d.measured}, model {d.predicted}; {where}"
         )
     if len(wrong) > LISTED:
         say(f"  ... and {len(wrong) - LISTED} more (--json lists all)")
