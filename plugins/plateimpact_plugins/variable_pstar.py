@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 import os
 from collections.abc import Sequence
@@ -18,6 +19,9 @@ from .separation import PlaneSeparation
 
 #: The smallest P* of a row [mm]: the plate constant's.
 SMALLEST_PSTAR_MM = CRITICAL_PENETRATION.range.low / CRITICAL_PENETRATION.scale
+
+#: Rows a table takes at most: a row per obliquity measured, a few in practice.
+MAX_ROWS = 1000
 
 TABLE_COLUMNS = (
     "obliquity_deg",
@@ -60,6 +64,8 @@ class PstarTable:
         start [m/s], transition end [m/s]), sorted by obliquity."""
         if len(rows) == 0:
             raise _fail("needs at least one row")
+        if len(rows) > MAX_ROWS:
+            raise _fail(f"{len(rows):,} rows; a table takes at most {MAX_ROWS:,}")
         values = []
         for number, row in enumerate(rows, start=1):
             if len(row) != len(TABLE_COLUMNS):
@@ -67,7 +73,8 @@ class PstarTable:
             try:
                 values.append([float(x) for x in row])
             except (TypeError, ValueError):
-                raise _fail(f"row {number} has a value that is not a number: {row!r}") from None
+                shown = f"{row!r:.80}"  # repr: control characters escaped
+                raise _fail(f"row {number} has a value that is not a number: {shown}") from None
         data = np.array(values)
         for number, (obliquity, ricochet, perforation, start, end) in enumerate(data, start=1):
             if not 0.0 <= obliquity < 90.0:
@@ -100,21 +107,27 @@ class PstarTable:
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str]) -> PstarTable:
         """A table from a CSV file with the header of :data:`TABLE_COLUMNS` (any order)."""
+        where = f"{os.fspath(path)!r:.200}"  # repr: control characters escaped
         try:
             with open(path, encoding="utf-8-sig", newline="") as handle:  # a BOM is allowed
                 reader = csv.DictReader(handle)
                 names = [name.strip() for name in reader.fieldnames or ()]
                 missing = set(TABLE_COLUMNS) - set(names)
                 if missing:
-                    raise _fail(f"{path}: missing columns {', '.join(sorted(missing))}")
+                    raise _fail(f"{where}: missing columns {', '.join(sorted(missing))}")
                 reader.fieldnames = names
-                rows = [[line[c] for c in TABLE_COLUMNS] for line in reader]
+                # one row more than a table takes is enough to refuse it: never the whole
+                # of a huge file in memory
+                rows = [
+                    [line[c] for c in TABLE_COLUMNS]
+                    for line in itertools.islice(reader, MAX_ROWS + 1)
+                ]
         except OSError as exc:
-            raise _fail(f"cannot read {path}: {exc.strerror}") from None
+            raise _fail(f"cannot read {where}: {exc.strerror}") from None
         except UnicodeDecodeError:
-            raise _fail(f"cannot read {path}: not UTF-8 text") from None
+            raise _fail(f"cannot read {where}: not UTF-8 text") from None
         except csv.Error as exc:
-            raise _fail(f"{path}: not a CSV table ({exc})") from None
+            raise _fail(f"{where}: not a CSV table ({str(exc)!r:.80})") from None
         return cls.from_rows(rows)
 
     @classmethod
