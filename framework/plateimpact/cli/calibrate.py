@@ -19,9 +19,16 @@ from ..simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions
 from ..storage.shots import Shots
+from ..storage.together import write_together
 from ..units import g, mm
 from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
-from .common import add_dpi_option, check_directory, save_figure_atomically, say, write_atomically
+from .common import (
+    add_dpi_option,
+    check_directory,
+    figure_output,
+    say,
+    text_output,
+)
 from .options import add_body_options, add_model_options, bodies, model_choice
 
 if TYPE_CHECKING:
@@ -101,12 +108,15 @@ def calibrate_command(args: argparse.Namespace) -> None:
     chosen = report.newton if args.method == "newton" else report.direct
     summary = _summary(args, report, chosen)
     summary["model"] = simulation.describe()
+    outputs = []  # the plate file and the figure of its fit land together
     if args.out is not None:
         provenance = _provenance(args, report, chosen, sphere)
         extra = {"calibration": {**provenance, "model": summary["model"]}}
-        write_atomically(args.out, plate_file_text(chosen.plate, extra), "--out")
+        outputs.append(text_output(args.out, plate_file_text(chosen.plate, extra), "--out"))
     if args.png is not None:
-        save_figure_atomically(_figure(report, sphere, simulation), args.png, dpi=args.dpi)
+        figure = _figure(report, sphere, simulation)
+        outputs.append(figure_output(figure, args.png, "--png", args.dpi))
+    write_together(outputs)
     if args.json:
         say(json.dumps(summary))
     else:

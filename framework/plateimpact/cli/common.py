@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
 from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, OutputError, check_output, write_text
+from ..storage.together import Output
 from ..storage.untrusted import printable
 
 if TYPE_CHECKING:
@@ -82,6 +83,20 @@ def save_figure_atomically(
     from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
     plotting.save(fig, path, flag, dpi=plotting.DPI if dpi is None else dpi)
+
+
+def text_output(path: str, text: str, flag: str, kind: str = "csv") -> Output:
+    """``text`` (UTF-8) to ``path``: one file of a set written together."""
+    return Output(path, flag, lambda handle: handle.write(text.encode()), kind)
+
+
+def figure_output(fig: Figure, path: str, flag: str, dpi: float | None = None) -> Output:
+    """A figure to ``path`` (format from its extension; ``dpi`` [dots per inch] for a
+    raster, default plotting's): one file of a set written together."""
+    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+
+    writer = plotting.figure_writer(fig, path, plotting.DPI if dpi is None else dpi)
+    return Output(path, flag, writer, "figure")
 
 
 def add_dpi_option(parser: argparse.ArgumentParser) -> None:

@@ -16,14 +16,16 @@ from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome
 from ..storage.archive import Archive
+from ..storage.together import write_together
 from .common import (
     UsageError,
     add_dpi_option,
     check_directory,
     csv_text,
+    figure_output,
     save_figure_atomically,
     say,
-    write_atomically,
+    text_output,
 )
 from .describe import shown
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
@@ -204,12 +206,14 @@ def limits_command(args: argparse.Namespace) -> None:
         found = find(
             simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution
         )
+    outputs = []  # the bands and their figure land together
     if args.csv is not None:
-        write_atomically(args.csv, _csv(found), "--csv")
+        outputs.append(text_output(args.csv, _csv(found), "--csv"))
     if args.png is not None:
         from ..limits.figures import plot_bands  # noqa: PLC0415 (matplotlib when drawing)
 
-        save_figure_atomically(plot_bands(found, label), args.png, dpi=args.dpi)
+        outputs.append(figure_output(plot_bands(found, label), args.png, "--png", args.dpi))
+    write_together(outputs)
     if args.json:
         say(json.dumps({"preset": label, **found.to_json()}))
     else:

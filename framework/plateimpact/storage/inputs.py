@@ -40,8 +40,9 @@ from .plate_file import plate_from_dict
 from .untrusted import described, load_json_file, printable, quoted
 
 FORMAT = "plateimpact-inputs-1"
-#: Keys of a record that are provenance or description, not read back.
-RECORD_ONLY = ("format", "label", "versions", "source_commit", "plugins")
+#: Keys of a record that are provenance or description, not read back (``csv_sha256``:
+#: the trajectory a ``run --trajectory`` sidecar describes, cli.sidecar).
+RECORD_ONLY = ("format", "label", "versions", "source_commit", "plugins", "csv_sha256")
 
 
 def si_key(declared: Parameter) -> str:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import glob
+import hashlib
 import os
 import stat
 import tempfile
@@ -103,14 +104,45 @@ def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> 
     return real
 
 
-def write_output(
+class Prepared:
+    """An output written in full to its temporary file beside ``target`` (flushed,
+    fsynced, given the target's mode), not yet in place: :meth:`commit` renames it over
+    the target, :meth:`discard` removes it (nothing after a commit)."""
+
+    def __init__(self, path: str, flag: str, target: Path, temporary: str) -> None:
+        self.path, self.flag, self.target, self.temporary = path, flag, target, temporary
+
+    def commit(self) -> None:
+        """Rename the temporary file over the target (atomic) and make it durable."""
+        try:
+            fault_point("replace")
+            os.replace(self.temporary, self.target)
+        except OSError as exc:
+            raise _write_error(self.flag, self.path, exc) from None
+        self.temporary = ""
+        fsync_directory(self.target.parent)
+
+    def discard(self) -> None:
+        if self.temporary:
+            with contextlib.suppress(OSError):
+                os.unlink(self.temporary)
+            self.temporary = ""
+
+
+def _write_error(flag: str, path: str, exc: OSError) -> OutputError:
+    reason = exc.strerror or os.strerror(exc.errno or errno.EIO)
+    return OutputError(f"{flag}: cannot write {path!r}: {reason}")
+
+
+def prepare_output(
     path: str | os.PathLike[str],
     flag: str,
     write: Callable[[IO[bytes]], object],
     kind: str = "csv",
-) -> Path:
-    """Write the file ``path`` atomically with ``write(handle)`` (a binary handle); the
-    target's mode and group are kept. Returns the real path written."""
+) -> Prepared:
+    """The file ``path`` written with ``write(handle)`` (a binary handle) to a temporary
+    file beside it, ready to :meth:`~Prepared.commit`; a failure at any stage removes
+    the temporary file and leaves the target as it was."""
     target = check_output(path, flag, kind)
     remove_dead_temporaries(target)
     temporary = ""
@@ -126,18 +158,30 @@ def write_output(
             os.fsync(handle.fileno())
         fault_point("chmod")
         keep_mode(temporary, target)
-        fault_point("replace")
-        os.replace(temporary, target)
-        temporary = ""
-        fsync_directory(target.parent)
-    except OSError as exc:
-        reason = exc.strerror or os.strerror(exc.errno or errno.EIO)
-        raise OutputError(f"{flag}: cannot write {os.fspath(path)!r}: {reason}") from None
-    finally:
+    except BaseException as exc:  # an interrupt midway too: no temporary file left
         if temporary:
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
-    return target
+        if isinstance(exc, OSError):
+            raise _write_error(flag, os.fspath(path), exc) from None
+        raise
+    return Prepared(os.fspath(path), flag, target, temporary)
+
+
+def write_output(
+    path: str | os.PathLike[str],
+    flag: str,
+    write: Callable[[IO[bytes]], object],
+    kind: str = "csv",
+) -> Path:
+    """Write the file ``path`` atomically with ``write(handle)`` (a binary handle); the
+    target's mode and group are kept. Returns the real path written."""
+    prepared = prepare_output(path, flag, write, kind)
+    try:
+        prepared.commit()
+    finally:
+        prepared.discard()
+    return prepared.target
 
 
 def write_text(path: str | os.PathLike[str], text: str, flag: str, kind: str = "csv") -> Path:
@@ -145,20 +189,31 @@ def write_text(path: str | os.PathLike[str], text: str, flag: str, kind: str = "
     return write_output(path, flag, lambda handle: handle.write(text.encode()), kind)
 
 
-def stream_text(
-    path: str | os.PathLike[str], chunks: Iterable[str], flag: str, kind: str = "csv"
-) -> Path:
-    """Write the texts ``chunks`` (UTF-8) to ``path`` as they are made, one at a time, so
-    that memory holds one chunk however long the file; atomically all the same: they go
-    into the temporary file, which replaces the target only after the last one. A failure
-    midway, in writing a chunk or in making one, leaves the old file as it was."""
+def streamed(
+    chunks: Iterable[str], digest: hashlib._Hash | None = None
+) -> Callable[[IO[bytes]], None]:
+    """A writer of the texts ``chunks`` (UTF-8), one at a time as they are made, so that
+    memory holds one chunk however long the file; ``digest`` (hashlib) is fed the bytes."""
 
     def write(handle: IO[bytes]) -> None:
         for chunk in chunks:
             fault_point("chunk")
-            handle.write(chunk.encode())
+            data = chunk.encode()
+            if digest is not None:
+                digest.update(data)
+            handle.write(data)
 
-    return write_output(path, flag, write, kind)
+    return write
+
+
+def stream_text(
+    path: str | os.PathLike[str], chunks: Iterable[str], flag: str, kind: str = "csv"
+) -> Path:
+    """Write the texts ``chunks`` (UTF-8) to ``path`` as they are made (:func:`streamed`);
+    atomically all the same: they go into the temporary file, which replaces the target
+    only after the last one. A failure midway, in writing a chunk or in making one,
+    leaves the old file as it was."""
+    return write_output(path, flag, streamed(chunks), kind)
 
 
 def pid_alive(pid: int) -> bool:
