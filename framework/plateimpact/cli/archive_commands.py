@@ -20,7 +20,7 @@ from ..progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..study import Study, StudyResults
-from .common import UsageError, add_dpi_option, check_directory, say
+from .common import UsageError, add_dpi_option, check_directory, output_directory, say
 from .describe import run_description
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
@@ -153,21 +153,21 @@ def study_collection(name: str) -> Any:
         ) from None
 
 
+#: Bytes of path kept for what reproduce writes inside --out: the archive's data files
+#: (report.h5.d/STUDY.VARIANT.HASH.nc), the figures and their temporary names.
+REPRODUCE_SPARE = 128
+
+
 def reproduce_command(args: argparse.Namespace) -> None:
     from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
 
     reproduce = study_collection("report")
     if args.out is None:  # a quick archive holds other scenes: never the full one's place
         args.out = "report-quick" if args.quick else "report"
-    out = Path(args.out)
-    if not str(args.out).strip():
-        raise UsageError("--out: give a directory name")
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out: {args.out!r} exists and is not a directory")
-    if not out.parent.resolve().is_dir():
-        raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
     if args.tag is not None and not _printable_tag(args.tag):
         raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
+    output_directory(args.out, "--out", REPRODUCE_SPARE)  # created, or one line
+    out = Path(args.out)
     try:
         # quick only when asked: a collection of an older signature still runs in full
         quick = {"quick": True} if args.quick else {}

@@ -13,10 +13,20 @@ import math
 import os
 import sys
 from collections.abc import Iterable, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
-from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, OutputError, check_output, write_text
+from ..storage.output import (
+    FIGURE_DPI,
+    FIGURE_DPI_RANGE,
+    OutputError,
+    check_output,
+    check_path,
+    not_writable,
+    shown_path,
+    write_text,
+)
 from ..storage.together import Output
 from ..storage.untrusted import printable
 
@@ -53,6 +63,37 @@ def check_directory(path: str | None, flag: str, kind: str = "csv") -> None:
     regular file, read-only, a figure format matplotlib cannot write)."""
     if path is not None:
         check_output(path, flag, kind)
+
+
+def output_directory(path: str, flag: str, spare: int = 0) -> Path:
+    """The directory ``path``, created if need be (its parent must exist), after refusing
+    with one line naming ``flag`` what could not hold the outputs: an empty name, a path
+    too long (``spare`` bytes kept for the names of the files inside), a name too long,
+    a file where a directory must be, a missing parent, a directory that cannot be
+    written (read-only filesystem included). Call it before any work."""
+    if not path.strip():
+        raise OutputError(f"{flag}: give a directory name, got {path!r}")
+    if "\0" in path:
+        raise OutputError(f"{flag}: a directory name cannot hold a NUL character")
+    real = Path(os.path.realpath(path))
+    check_path(real, flag, spare)
+    if real.exists():
+        if not real.is_dir():
+            raise OutputError(f"{flag}: {shown_path(path)} exists and is not a directory")
+        where = real
+    else:
+        where = real.parent
+        if not where.is_dir():
+            raise OutputError(f"{flag}: directory {shown_path(str(where))} does not exist")
+    refused = not_writable(where)
+    if refused:
+        raise OutputError(f"{flag}: directory {shown_path(str(where))} {refused}")
+    try:
+        real.mkdir(exist_ok=True)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise OutputError(f"{flag}: cannot create {shown_path(path)}: {reason}") from None
+    return real
 
 
 def dots_per_inch(text: str) -> float:

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import PlateImpactError
+from .untrusted import printable
 
 #: What ``kind`` may end with; ``None``: any name.
 SUFFIXES: dict[str, tuple[str, ...] | None] = {
@@ -70,35 +71,89 @@ def umask() -> int:
     return current
 
 
+def _path_max(directory: str) -> int:
+    """The longest path the system takes [bytes, with its terminating NUL]."""
+    try:
+        return os.pathconf(directory if os.path.isdir(directory) else "/", "PC_PATH_MAX")
+    except (OSError, ValueError):
+        return 4096
+
+
+def shown_path(text: str, limit: int = 200) -> str:
+    """A path for a one-line message: quoted, escaped, cut to ``limit`` characters."""
+    return printable(repr(text), limit)
+
+
+def not_writable(directory: str | os.PathLike[str]) -> str | None:
+    """Why this process cannot create files in ``directory`` (None if it can)."""
+    if os.access(directory, os.W_OK | os.X_OK):
+        return None
+    with contextlib.suppress(OSError):
+        if os.statvfs(directory).f_flag & os.ST_RDONLY:
+            return "is on a read-only filesystem"
+    return "is not writable"
+
+
+def check_path(real: Path, flag: str, spare: int = 0) -> None:
+    """Refuse a path the filesystem could not take: longer than PATH_MAX (less ``spare``
+    bytes kept for names inside it), a name in it longer than NAME_MAX, or a name in it
+    that is a file where a directory must be."""
+    limit = _path_max(str(real.parent))
+    size = len(os.fsencode(real))
+    if size + spare >= limit:
+        room = f" (and {spare} for the files inside)" if spare else ""
+        raise OutputError(
+            f"{flag}: the path is {size:,} bytes long; at most {limit - 1 - spare:,} are "
+            f"taken{room}"
+        )
+    ancestor = real
+    while not os.path.lexists(ancestor) and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    for part in real.relative_to(ancestor).parts if ancestor != real else ():
+        longest = _name_max(str(ancestor) if os.path.isdir(ancestor) else "/")
+        if len(os.fsencode(part)) > longest:
+            raise OutputError(f"{flag}: the name {shown_path(part)} is longer than {longest} bytes")
+    if real != ancestor and not os.path.isdir(ancestor):
+        raise OutputError(f"{flag}: {shown_path(str(ancestor))} is not a directory")
+
+
 def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> Path:
     """The real file ``path`` names (links followed), after refusing what cannot be
     written there. Call it before any computation."""
     text = os.fspath(path)
     if not text.strip():
         raise OutputError(f"{flag}: give a file name, got {text!r}")
+    if "\0" in text:
+        raise OutputError(f"{flag}: a file name cannot hold a NUL character")
     real = Path(os.path.realpath(text))
     directory = str(real.parent)
+    check_path(real, flag)
     if os.path.isdir(directory) and len(real.name.encode()) > _name_max(directory):
         raise OutputError(f"{flag}: the file name is longer than {_name_max(directory)} bytes")
     if text.endswith(os.sep) or real.is_dir():
-        raise OutputError(f"{flag}: {text!r} is a directory; give a file name")
+        raise OutputError(f"{flag}: {shown_path(text)} is a directory; give a file name")
     if not os.path.isdir(directory):
-        raise OutputError(f"{flag}: directory {directory!r} does not exist")
-    if not os.access(directory, os.W_OK | os.X_OK):
-        raise OutputError(f"{flag}: directory {directory!r} is not writable")
+        raise OutputError(f"{flag}: directory {shown_path(directory)} does not exist")
+    refused = not_writable(directory)
+    if refused:
+        raise OutputError(f"{flag}: directory {shown_path(directory)} {refused}")
     if real.exists() or real.is_symlink():
         try:
             mode = os.stat(real).st_mode
         except OSError as exc:
-            raise OutputError(f"{flag}: {text!r} cannot be examined: {exc.strerror}") from None
+            raise OutputError(
+                f"{flag}: {shown_path(text)} cannot be examined: {exc.strerror}"
+            ) from None
         if not stat.S_ISREG(mode):
-            raise OutputError(f"{flag}: {text!r} is not a regular file; refusing to replace it")
+            raise OutputError(
+                f"{flag}: {shown_path(text)} is not a regular file; refusing to replace it"
+            )
         if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
-            raise OutputError(f"{flag}: {text!r} is read-only; refusing to replace it")
+            raise OutputError(f"{flag}: {shown_path(text)} is read-only; refusing to replace it")
     suffixes = SUFFIXES.get(kind)
     if suffixes is not None and real.suffix.lower() not in suffixes:
         raise OutputError(
-            f"{flag}: cannot tell the format of {text!r}; end the name with one of "
+            f"{flag}: cannot tell the format of {shown_path(text)}; end the name with one of "
             f"{', '.join(suffixes)}"
         )
     return real
@@ -131,7 +186,7 @@ class Prepared:
 
 def _write_error(flag: str, path: str, exc: OSError) -> OutputError:
     reason = exc.strerror or os.strerror(exc.errno or errno.EIO)
-    return OutputError(f"{flag}: cannot write {path!r}: {reason}")
+    return OutputError(f"{flag}: cannot write {shown_path(path)}: {reason}")
 
 
 def prepare_output(
