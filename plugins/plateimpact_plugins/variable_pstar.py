@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import csv
-import itertools
+import io
 import math
 import os
 from collections.abc import Sequence
@@ -20,8 +20,10 @@ from .separation import PlaneSeparation
 #: The smallest P* of a row [mm]: the plate constant's.
 SMALLEST_PSTAR_MM = CRITICAL_PENETRATION.range.low / CRITICAL_PENETRATION.scale
 
-#: Rows a table takes at most: a row per obliquity measured, a few in practice.
+#: Rows a table takes at most: a row per obliquity measured, a few in practice; and the
+#: largest table file read [bytes] (1000 rows of five long numbers).
 MAX_ROWS = 1000
+MAX_BYTES = 1 << 20
 
 TABLE_COLUMNS = (
     "obliquity_deg",
@@ -109,19 +111,17 @@ class PstarTable:
         """A table from a CSV file with the header of :data:`TABLE_COLUMNS` (any order)."""
         where = f"{os.fspath(path)!r:.200}"  # repr: control characters escaped
         try:
-            with open(path, encoding="utf-8-sig", newline="") as handle:  # a BOM is allowed
-                reader = csv.DictReader(handle)
-                names = [name.strip() for name in reader.fieldnames or ()]
-                missing = set(TABLE_COLUMNS) - set(names)
-                if missing:
-                    raise _fail(f"{where}: missing columns {', '.join(sorted(missing))}")
-                reader.fieldnames = names
-                # one row more than a table takes is enough to refuse it: never the whole
-                # of a huge file in memory
-                rows = [
-                    [line[c] for c in TABLE_COLUMNS]
-                    for line in itertools.islice(reader, MAX_ROWS + 1)
-                ]
+            with open(path, "rb") as handle:  # never more than a table can hold
+                data = handle.read(MAX_BYTES + 1)
+            if len(data) > MAX_BYTES:
+                raise _fail(f"{where}: more than {MAX_BYTES:,} bytes; a table holds at most that")
+            reader = csv.DictReader(io.StringIO(data.decode("utf-8-sig"), newline=""))
+            names = [name.strip() for name in reader.fieldnames or ()]
+            missing = set(TABLE_COLUMNS) - set(names)
+            if missing:
+                raise _fail(f"{where}: missing columns {', '.join(sorted(missing))}")
+            reader.fieldnames = names
+            rows = [[line[c] for c in TABLE_COLUMNS] for line in reader]
         except OSError as exc:
             raise _fail(f"cannot read {where}: {exc.strerror}") from None
         except UnicodeDecodeError:

@@ -43,6 +43,7 @@ from .shot_rows import (
     check_columns,
     check_rows,
 )
+from .untrusted import MAX_BYTES, printable
 
 __all__ = ["COLUMNS", "PERFORATION_COLUMNS", "REQUIRED_COLUMNS", "RESIDUAL_SPEED", "Shots"]
 
@@ -211,11 +212,17 @@ class Shots:
         """Shots from a CSV file (see the module's description of the columns)."""
         source = os.fspath(path)
         try:
-            with open(source, encoding="utf-8-sig", newline="") as handle:  # BOM allowed
-                text = handle.read()
+            with open(source, "rb") as handle:  # never more than a shot file can hold
+                data = handle.read(MAX_BYTES + 1)
+            text = data.decode("utf-8-sig")  # a BOM is allowed
         except (OSError, UnicodeDecodeError) as exc:
             reason = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
-            raise ShotDataError(f"{source}: cannot read: {reason}") from None
+            raise ShotDataError(f"{printable(source, 200)}: cannot read: {reason}") from None
+        if len(data) > MAX_BYTES:
+            raise ShotDataError(
+                f"{printable(source, 200)}: more than {MAX_BYTES:,} bytes; a shot file holds "
+                "at most that"
+            )
         return cls.from_csv_text(text, source=source)
 
     @classmethod
@@ -231,7 +238,10 @@ class Shots:
                 f"{source}: empty file, expected a header naming {', '.join(REQUIRED_COLUMNS)} "
                 f"and one of {', '.join(PERFORATION_COLUMNS)}"
             )
-        records = list(csv.reader(line for _, line in lines))
+        try:
+            records = list(csv.reader(line for _, line in lines))
+        except csv.Error as exc:  # a field beyond the csv module's limit
+            raise ShotDataError(f"{source}: not a CSV table ({exc})") from None
         header = [name.strip() for name in records[0]]
         check_columns(f"{source} line {lines[0][0]}", header)
         rows, labels = [], []
