@@ -205,7 +205,6 @@ def _study_results(archive: Archive, runs: list[str]) -> StudyResults:
 
 
 def show_command(args: argparse.Namespace) -> None:
-
     archive = Archive(args.archive)
     for name in archive.runs():
         say("\n".join(run_description(archive, name)))
