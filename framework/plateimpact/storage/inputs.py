@@ -37,7 +37,7 @@ from ..registry import KINDS, PluginRegistry, default_registry
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
 from .plate_file import plate_from_dict
-from .untrusted import described, load_json_file, printable, quoted
+from .untrusted import described, load_json_file, printable
 
 FORMAT = "plateimpact-inputs-1"
 #: Keys of a record that are provenance or description, not read back (``csv_sha256``:
@@ -202,9 +202,9 @@ def read_run_inputs(data: object, source: str, registry: PluginRegistry | None =
     if isinstance(data, dict) and isinstance(data.get("inputs"), dict):
         data = data["inputs"]
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        found = quoted(data.get("format")) if isinstance(data, dict) else described(data)
+        found = data.get("format") if isinstance(data, dict) else type(data).__name__
         raise InputsError(
-            f"{source}: not a plateimpact inputs record (format {found}, expected "
+            f"{source}: not a plateimpact inputs record (format {found!r:.60}, expected "
             f"{FORMAT!r}, as 'plateimpact run --json' writes)"
         )
     where = f"{source}: "

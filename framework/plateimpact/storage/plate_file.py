@@ -24,7 +24,7 @@ from ..errors import ParameterError, PlateFileError
 from ..parameters import Parameter
 from ..registry import PluginRegistry, default_registry
 from .output import write_text
-from .untrusted import described, load_json_file, printable, quoted
+from .untrusted import described, load_json_file, printable
 
 FORMAT = "plateimpact-plate-1"
 #: Keys that are not constants.
@@ -68,7 +68,7 @@ def plate_from_dict(
         raise PlateFileError(f"{source}: expected a JSON object, got {described(data)}")
     if data.get("format") != FORMAT:
         raise PlateFileError(
-            f"{source}: not a plateimpact plate file (format {quoted(data.get('format'))}, "
+            f"{source}: not a plateimpact plate file (format {data.get('format')!r:.60}, "
             f"expected {FORMAT!r})"
         )
     declarations = _declarations(registry)
@@ -88,7 +88,7 @@ def plate_from_dict(
         declared = declarations.get(key)
         if declared is None:
             known = ", ".join(sorted(declarations))
-            raise PlateFileError(f"{source}: unknown key {quoted(key)} (plate keys: {known})")
+            raise PlateFileError(f"{source}: unknown key {key!r:.60} (plate keys: {known})")
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise PlateFileError(
                 f"{source}: {key}: must be a number {declared.describe_range()}, got "
