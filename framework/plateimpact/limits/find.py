@@ -25,7 +25,7 @@ from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import source_commit, versions
-from .finder import SECTIONS, locate
+from .finder import RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
 from .regimes import Regime, regime_codes
 
@@ -109,22 +109,34 @@ def _interval(name: str, values: tuple[float, float], declared: Any) -> tuple[fl
 
 
 def _steps(
-    tolerance: float, resolution: float, span: float, lines: int, unit: str, scale: float
+    tolerance: float,
+    resolution: float,
+    span: tuple[float, float],
+    lines: int,
+    unit: str,
+    scale: float,
 ) -> None:
-    """Tolerance in (0, span]; resolution in [tolerance, span]; a scan of at most
-    MAX_SCAN_SCENES scenes."""
-    shown = f"{span / scale:.6g} {unit}"
-    if not (math.isfinite(tolerance) and 0.0 < tolerance <= span):
+    """Tolerance in [RELATIVE_FLOOR of the range's largest value, the range's width];
+    resolution in [tolerance, the width]; a scan of at most MAX_SCAN_SCENES scenes. The
+    floor is what a double resolves there: finer cuts would coincide (limits.finder)."""
+    width = span[1] - span[0]
+    shown = f"{width / scale:.6g} {unit}"
+    floor = finest_tolerance(np.array([span[0]]), np.array([span[1]]))
+    if not (math.isfinite(tolerance) and floor <= tolerance <= width):
         raise ParameterError(
-            "tolerance", f"tolerance must be in (0, {shown}] (the range), got {tolerance / scale:g}"
+            "tolerance",
+            f"tolerance must be in [{floor / scale:.3g}, {width / scale:.6g}] {unit} (from "
+            f"{RELATIVE_FLOOR:g} of "
+            f"the range's largest value, about what a double resolves there, to the range), "
+            f"got {tolerance / scale:g}",
         )
-    if not (math.isfinite(resolution) and tolerance <= resolution <= span):
+    if not (math.isfinite(resolution) and tolerance <= resolution <= width):
         raise ParameterError(
             "resolution",
-            f"resolution must be in [{tolerance / scale:g}, {shown}] (from the tolerance to "
-            f"the range), got {resolution / scale:g}",
+            f"resolution must be in [{tolerance / scale:g}, {width / scale:.6g}] {unit} (from "
+            f"the tolerance to the range), got {resolution / scale:g}",
         )
-    scan = lines * (math.ceil(span / resolution) + 1)
+    scan = lines * (math.ceil(width / resolution) + 1)
     if scan > MAX_SCAN_SCENES:
         raise ParameterError(
             "resolution",
@@ -222,7 +234,7 @@ def along_speed(
     fixed = _floats("obliquities", obliquities)
     IMPACT_OBLIQUITY.check(fixed)
     span = _interval("speeds", speeds, IMPACT_SPEED)
-    _steps(tolerance, resolution, span[1] - span[0], fixed.size, "m/s", 1.0)
+    _steps(tolerance, resolution, span, fixed.size, "m/s", 1.0)
     (found,) = _find(
         simulation, sphere, [plate], SPEED, fixed, span, tolerance, resolution, executor
     )
@@ -248,7 +260,7 @@ def along_obliquity(
     fixed = _floats("speeds", speeds)
     IMPACT_SPEED.check(fixed)
     span = _interval("obliquities", obliquities, IMPACT_OBLIQUITY)
-    _steps(tolerance, resolution, span[1] - span[0], fixed.size, "deg", _DEG)
+    _steps(tolerance, resolution, span, fixed.size, "deg", _DEG)
     (found,) = _find(
         simulation, sphere, [plate], OBLIQUITY, fixed, span, tolerance, resolution, executor
     )
