@@ -237,8 +237,11 @@ PLATE = ["--preset", "2024-T3/3.18"]
         (["--fit", "pstar", "--by-obliquity", "--alpha-fit", *PLATE], "--alpha-fit: not with"),
         (["--fit", "pstar", "--speed-sigma", "0", *PLATE], "--speed-sigma: speed_sigma must be"),
         (["--fit", "pstar", "--residual-sigma", "nan", *PLATE], "--residual-sigma:"),
-        (["--fit", "pstar", "--tolerance", "0", *PLATE], "--tolerance: must be in"),
-        (["--fit", "pstar", "--resolution", "0.001", *PLATE], "--resolution: must be in"),
+        (["--fit", "pstar", "--tolerance", "0", *PLATE], "--tolerance: tolerance must be in"),
+        (["--fit", "pstar", "--resolution", "0.001", *PLATE], "[0.01, 100] m/s"),
+        # below one ulp of the shots' speeds: the old finder never returned
+        (["--fit", "pstar", "--tolerance", "1e-14", *PLATE], "[1e-09, 10] m/s"),
+        (["--fit", "pstar", "--by-obliquity", "--tolerance", "1e-300", *PLATE], "--tolerance: "),
         (["--fit", "pstar", "--failure", "variable-pstar", *PLATE], "does not read"),
         (["--fit", "pstar", "--pstar", "3", *PLATE], "--pstar: not with --fit pstar"),
         (["--fit", "pstar", "--set", "plate.pstar=3", *PLATE], "plate.pstar: not with --fit"),

@@ -17,10 +17,37 @@ import numpy as np
 
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
+from ..errors import ParameterError
 from ..limits import locate, regime_codes
+from ..limits.finder import RELATIVE_FLOOR
 from ..results import Outcome
+from ..scene import IMPACT_SPEED
 from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
 from .outcome_model import Bands, ShotLines
+
+#: The finder's tolerance [m/s]: from RELATIVE_FLOOR of the fastest speed a line can
+#: reach (what a double resolves there: limits.finder) to 10 m/s; its resolution [m/s]
+#: from the tolerance to 100 m/s.
+TOLERANCE_RANGE = (RELATIVE_FLOOR * IMPACT_SPEED.range.high, 10.0)
+MAX_RESOLUTION = 100.0
+
+
+def check_finder(resolution: float, tolerance: float) -> None:
+    """:class:`ParameterError` (``tolerance`` or ``resolution``) unless the finder's
+    settings [m/s] are in their ranges: checked before any scene runs."""
+    low, high = TOLERANCE_RANGE
+    if not (math.isfinite(tolerance) and low <= tolerance <= high):
+        raise ParameterError(
+            "tolerance",
+            f"tolerance must be in [{low:g}, {high:g}] m/s (from {RELATIVE_FLOOR:g} of the "
+            f"fastest speed, about what a double resolves there), got {tolerance:g}",
+        )
+    if not (math.isfinite(resolution) and tolerance <= resolution <= MAX_RESOLUTION):
+        raise ParameterError(
+            "resolution",
+            f"resolution must be in [{tolerance:g}, {MAX_RESOLUTION:g}] m/s (from the "
+            f"tolerance), got {resolution:g}",
+        )
 
 
 @attrs.frozen
@@ -48,6 +75,7 @@ class LineModel:
         resolution: float,
         tolerance: float,
     ) -> None:
+        check_finder(resolution, tolerance)
         self.simulation, self.sphere, self.plate = simulation, sphere, plate
         self.resolution, self.tolerance = resolution, tolerance
         self.cost = Cost()

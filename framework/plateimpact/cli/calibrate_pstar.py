@@ -10,7 +10,7 @@ import os
 from typing import Any
 
 from ..bodies import Plate, Sphere
-from ..calibration.model_lines import Cost
+from ..calibration.model_lines import Cost, check_finder
 from ..calibration.outcome_model import (
     OUTCOME_BLUNDER,
     RESIDUAL_SIGMA_BOUNDS,
@@ -130,7 +130,8 @@ def pstar_command(args: argparse.Namespace) -> None:
         "resolution": SPEED_RESOLUTION if args.resolution is None else args.resolution,
         "tolerance": SPEED_TOLERANCE if args.tolerance is None else args.tolerance,
     }
-    _check_finder(**finder)
+    typed(args).update({"tolerance": "--tolerance", "resolution": "--resolution"})
+    check_finder(**finder)
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
             table = fit_pstar_by_obliquity(
@@ -152,16 +153,6 @@ def pstar_command(args: argparse.Namespace) -> None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
         write_atomically(args.out, plate_file_text(fit.plate, extra), "--out")
     print(json.dumps(summary) if args.json else _fit_text(args, fit))
-
-
-def _check_finder(resolution: float, tolerance: float) -> None:
-    if not (math.isfinite(tolerance) and 0.0 < tolerance <= 10.0):
-        raise UsageError(f"--tolerance: must be in (0, 10] m/s, got {tolerance:g}")
-    if not (math.isfinite(resolution) and tolerance <= resolution <= 100.0):
-        raise UsageError(
-            f"--resolution: must be in [{tolerance:g}, 100] m/s (from the tolerance), "
-            f"got {resolution:g}"
-        )
 
 
 def _finite(x: float) -> float | None:
