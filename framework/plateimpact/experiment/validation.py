@@ -253,7 +253,7 @@ def _disagreements(
     classes = measured_classes(shots)
     disagreements = tuple(
         Disagreement(
-            shots.labels[i],
+            shots.labels[int(i)],
             float(shots.impact_speed[i]),
             float(shots.impact_obliquity[i]),
             classes[i],
