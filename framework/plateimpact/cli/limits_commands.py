@@ -55,6 +55,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         metavar="OUTCOME",
         help=f"print only the bands of this outcome ({', '.join(OUTCOMES)}); repeatable",
     )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help=f"scan more than {lim.MAX_SCAN_SCENES:,} scenes (memory stays bounded: they run "
+        "10,000 at a time; the time does not)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--csv", metavar="FILE", help="write the bands as CSV")
     p.add_argument("--png", metavar="FILE", help="draw the bands")
@@ -200,8 +206,9 @@ def limits_command(args: argparse.Namespace) -> None:
         find = lim.along_obliquity
     with reporting_scenes("limits"):  # a count of scenes, per pass, on a terminal after 2 s
         found = find(
-            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution
-        )
+            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution,
+            max_scenes=None if args.force else lim.MAX_SCAN_SCENES,
+        )  # fmt: skip
     if args.csv is not None:
         write_atomically(args.csv, _csv(found), "--csv")
     if args.png is not None:

@@ -43,6 +43,9 @@ SECTIONS = 16
 #: 28 ulps and distinct, and it is the tightest rtol the integrators take (a boundary
 #: finer than that is below what the integration itself resolves).
 RELATIVE_FLOOR = 1e-13
+#: The most scan samples located together (a group of lines): what the finder holds,
+#: some 40 bytes a sample, stays under 40 MB however many lines a request has.
+GROUP_SCENES = 1_000_000
 #: Passes never needed when the floor holds: each halves a bracket at least, and
 #: span / tolerance <= 2 / RELATIVE_FLOOR < 2**45.
 MAX_PASSES = 64
@@ -73,15 +76,20 @@ def _ragged(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return group, np.arange(counts.sum()) - starts[group]
 
 
+def scan_intervals(starts: np.ndarray, ends: np.ndarray, resolution: float) -> np.ndarray:
+    """How many intervals each line's scan has (its samples are one more)."""
+    # the 1e-12 keeps a span that is an exact multiple of the resolution from gaining a
+    # needless interval to rounding
+    return np.maximum(np.ceil((ends - starts) / resolution * (1.0 - 1e-12)), 1).astype(np.int64)
+
+
 def scan_points(
     starts: np.ndarray, ends: np.ndarray, resolution: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The scan: each line's samples at equal spacing <= ``resolution``, both ends
     included. Returns (line of each sample, its index on the line, its position)."""
     span = ends - starts
-    # the 1e-12 keeps a span that is an exact multiple of the resolution from gaining a
-    # needless interval to rounding
-    intervals = np.maximum(np.ceil(span / resolution * (1.0 - 1e-12)), 1).astype(np.int64)
+    intervals = scan_intervals(starts, ends, resolution)
     line, k = _ragged(intervals + 1)
     x = starts[line] + span[line] * (k / intervals[line])
     last = k == intervals[line]
@@ -123,7 +131,9 @@ def locate(
     """Every regime change along the lines [starts, ends], each bracketed to within
     ``tolerance`` (same unit as the positions); :class:`ParameterError` (``tolerance``)
     for a tolerance finer than :func:`finest_tolerance` of the lines, before any
-    evaluation, or if a pass fails to shrink a bracket."""
+    evaluation, or if a pass fails to shrink a bracket. Lines whose scans hold more than
+    GROUP_SCENES samples are located a group at a time (what is held grows with a
+    group, not with the request); a single line may hold at most GROUP_SCENES."""
     floor = finest_tolerance(starts, ends)
     if not (math.isfinite(tolerance) and tolerance >= floor):
         raise ParameterError(
@@ -131,6 +141,54 @@ def locate(
             f"tolerance must be at least {floor:.3g} ({RELATIVE_FLOOR:g} of the largest "
             f"position, what a double resolves there), got {tolerance:g}",
         )
+    samples = scan_intervals(starts, ends, resolution) + 1
+    if samples.size and samples.max() > GROUP_SCENES:
+        raise ParameterError(
+            "resolution",
+            f"resolution {resolution:g} makes {int(samples.max()):,} samples on one line, "
+            f"more than {GROUP_SCENES:,}: coarsen it or shorten the line",
+        )
+    # consecutive lines, each group's samples at most GROUP_SCENES
+    bounds, total = [0], 0
+    for i, n in enumerate(samples.tolist()):
+        if total + n > GROUP_SCENES:
+            bounds.append(i)
+            total = 0
+        total += n
+    bounds.append(samples.size)
+    parts = [
+        _locate(
+            _shifted(evaluate, lo), starts[lo:hi], ends[lo:hi], resolution, tolerance, sections
+        )  # fmt: skip
+        for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
+    ]
+    if len(parts) == 1:
+        return parts[0]
+
+    def joined(name: str) -> np.ndarray:
+        return np.concatenate([getattr(part, name) for part in parts])
+
+    line = np.concatenate([p.line + lo for p, lo in zip(parts, bounds[:-1], strict=True)])
+    return Located(
+        line, joined("low"), joined("high"), joined("below"), joined("above"),
+        joined("first"), sum(p.scenes for p in parts), max(p.passes for p in parts),
+    )  # fmt: skip
+
+
+def _shifted(evaluate: Evaluate, first: int) -> Evaluate:
+    """``evaluate`` for a group of lines that starts at line ``first``."""
+    return lambda line, x: evaluate(line + first, x)
+
+
+def _locate(
+    evaluate: Evaluate,
+    starts: np.ndarray,
+    ends: np.ndarray,
+    resolution: float,
+    tolerance: float,
+    sections: int,
+) -> Located:
+    """:func:`locate` on one group of lines."""
     line, k, x = scan_points(starts, ends, resolution)
     codes = np.asarray(evaluate(line, x), dtype=np.int64)
     scenes = x.size
