@@ -266,17 +266,18 @@ def test_too_few_shots(tmp_path, capsys):
 
 
 def test_shots_far_from_every_boundary_do_not_identify_pstar(tmp_path, capsys):
-    """Slow ricochets at 60 deg: only a P* below about 0.7 mm makes them perforate; the
-    shots bound P* from below and say nothing more."""
+    """Slow ricochets at 60 deg, and one embedment at 30 m/s that no P* explains: only a
+    P* below about 0.7 mm makes the ricochets perforate, so the shots bound P* from below
+    and say nothing more."""
     path = tmp_path / "far.csv"
     rows = "".join(f"{v},60,ricochet\n" for v in (100, 110, 120, 130, 140, 150))
-    path.write_text("impact_speed_m_s,impact_obliquity_deg,outcome\n" + rows)
+    path.write_text("impact_speed_m_s,impact_obliquity_deg,outcome\n" + rows + "30,60,embedment\n")
     assert main(["calibrate", str(path), "--fit", "pstar", *PLATE, *FAST]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "P* not identified: the likelihood does not fall" in err
     assert "from one side only" in err
     # shots that no P* in the range moves: the likelihood is flat
-    rows = "".join(f"{v},0,embedment\n" for v in (10, 11, 12, 13, 14, 15))
+    rows = "".join(f"{v},0,embedment\n" for v in (10, 11, 12, 13, 14)) + "12,0,ricochet\n"
     path.write_text("impact_speed_m_s,impact_obliquity_deg,outcome\n" + rows)
     assert main(["calibrate", str(path), "--fit", "pstar", *PLATE, *FAST]) == 2
     assert "P* not identified: the likelihood is flat" in capsys.readouterr().err

@@ -23,6 +23,7 @@ from ..calibration.pstar import (
     fit_pstar,
     fit_pstar_by_obliquity,
 )
+from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, Estimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..progress import reporting_scenes
@@ -132,15 +133,19 @@ def pstar_command(args: argparse.Namespace) -> None:
     }
     typed(args).update({"tolerance": "--tolerance", "resolution": "--resolution"})
     check_finder(**finder)
+    bound = None if args.force else MAX_FIT_SCENES
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
             table = fit_pstar_by_obliquity(
-                shots, plate, sphere=sphere, simulation=simulation, model=model, **finder
-            )
+                shots, plate, sphere=sphere, simulation=simulation, model=model,
+                resolution=finder["resolution"], tolerance=finder["tolerance"],
+                max_scenes=bound,
+            )  # fmt: skip
         else:
             fit = fit_pstar(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
-                fit_alpha=args.alpha_fit, **finder,
+                fit_alpha=args.alpha_fit, resolution=finder["resolution"],
+                tolerance=finder["tolerance"], max_scenes=bound,
             )  # fmt: skip
     if args.by_obliquity:
         summary = _table_summary(args, table, simulation, finder, sphere)
