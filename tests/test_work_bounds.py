@@ -5,6 +5,8 @@ over its bound is refused before any scene runs, naming the option that lifts it
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from test_output_files import assert_one_line, run_cli
@@ -16,6 +18,7 @@ from plateimpact.limits import chunked, finder
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/1.27")
+ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture
@@ -90,3 +93,82 @@ def test_the_command_line_names_force_and_force_lifts_the_bound(monkeypatch, bat
     assert batches == []
     code, out, err = run_cli([*argv, "--force"])
     assert code == 0 and err == "" and "ballistic limit" in out
+
+
+# -- validate and the a, b fit -------------------------------------------------------------
+
+SHOTS = pi.Shots.from_columns(
+    {"impact_speed_m_s": [400, 450, 600, 410, 500, 590],
+     "impact_obliquity_deg": [30] * 3 + [60] * 3, "perforated": [0, 1, 1, 0, 0, 1]}
+)  # fmt: skip
+
+
+@pytest.fixture
+def no_scene(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(self, scenes, **kwargs):  # type: ignore[no-untyped-def]
+        raise AssertionError("a scene ran before the request was refused")
+
+    monkeypatch.setattr(pi.Simulation, "run_batch", refuse)
+
+
+def test_validate_is_bounded_before_any_scene_by_its_shots_and_every_line(no_scene):
+    """6 shots on 2 lines; boundaries sought over 200-900 m/s (half the slowest shot to
+    1.5 times the fastest): 701 samples a line at 1 m/s, so 6 + 2 x 701 = 1,408 scenes."""
+    simulation = pi.Simulation.from_names()
+    with pytest.raises(WorkBoundError, match=r"up to 1,408 scenes .* more than 1,407: .*--force"):
+        pi.validate(simulation, SPHERE, PLATE, SHOTS, max_scenes=1407)
+    with pytest.raises(pi.ParameterError) as info:  # below what doubles resolve at 900 m/s
+        pi.validate(simulation, SPHERE, PLATE, SHOTS, tolerance=1e-14)
+    assert info.value.parameter == "tolerance"
+
+
+def test_validate_runs_its_shots_a_chunk_at_a_time_bit_for_bit(monkeypatch, batches):
+    simulation = pi.Simulation.from_names()
+    coarse = {"resolution": 50.0, "tolerance": 5.0}  # a short boundary search
+    whole = pi.validate(simulation, SPHERE, PLATE, SHOTS, **coarse)
+    monkeypatch.setattr(chunked, "RUN_CHUNK", 4)
+    batches.clear()
+    parts = pi.validate(simulation, SPHERE, PLATE, SHOTS, **coarse)
+    assert max(batches) <= 4
+    for name in ("predicted_outcome", "predicted_exit_speed", "predicted_exit_obliquity"):
+        np.testing.assert_array_equal(getattr(parts, name), getattr(whole, name))
+    assert parts.disagreements == whole.disagreements
+
+
+def test_validate_on_the_command_line_names_force_and_force_lifts_the_bound(tmp_path, monkeypatch):
+    path = tmp_path / "shots.csv"
+    path.write_text(SHOTS.to_csv_text())
+    monkeypatch.setattr("plateimpact.cli.validate.MAX_VALIDATE_SCENES", 1000)
+    argv = ["validate", str(path), "--preset", "2024-T3/1.27"]
+    code, _, err = run_cli(argv)
+    assert_one_line(code, err, "validate: up to 1,408 scenes", "more than 1,000", "--force")
+    code, out, err = run_cli([*argv, "--force"])
+    assert code == 0 and "outcome agreement" in out, err
+
+
+NORMAL = "studies/data/shots_2024T3_3.18mm.csv"  # 15 shots at normal incidence
+
+
+def test_the_ab_fit_is_bounded_before_any_scene_by_its_normal_shots(no_scene, monkeypatch):
+    """213 scenes a shot at most: 3 x (1 + 20) Newton runs, 3 x 50 direct-fit runs."""
+    shots = pi.Shots.from_csv(ROOT / NORMAL)
+    plate = presets.plate("2024-T3/3.18")
+    with pytest.raises(WorkBoundError, match=r"up to 3,195 scenes .* more than 3,194"):
+        pi.calibration.calibrate(shots, plate, max_scenes=3194)
+    monkeypatch.setattr("plateimpact.cli.calibrate.MAX_FIT_SCENES", 3194)
+    argv = ["calibrate", str(ROOT / NORMAL), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
+    code, _, err = run_cli(argv)
+    assert_one_line(code, err, "a, b fit: up to 3,195 scenes", "--force")
+
+
+def test_the_model_residual_speeds_run_a_chunk_at_a_time_bit_for_bit(monkeypatch, batches):
+    simulation = pi.Simulation.from_names()
+    plate = presets.plate("2024-T3/3.18")
+    speeds, constants = np.linspace(300.0, 900.0, 7), [(1e9, 1200.0), (1.1e9, 1300.0)]
+    whole = pi.calibration.model_residual_speeds(simulation, SPHERE, plate, speeds, constants)
+    assert batches == [14]
+    monkeypatch.setattr(chunked, "RUN_CHUNK", 3)
+    parts = pi.calibration.model_residual_speeds(simulation, SPHERE, plate, speeds, constants)
+    assert max(batches[1:]) <= 3
+    np.testing.assert_array_equal(parts, whole)
+    assert (whole > 0).any() and (whole == 0).any()

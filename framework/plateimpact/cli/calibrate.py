@@ -104,7 +104,10 @@ def calibrate_command(args: argparse.Namespace) -> None:
     sphere, given, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given.thickness, given.constants)
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
-        report = calibrate(shots, plate, sphere=sphere, simulation=simulation)
+        report = calibrate(
+            shots, plate, sphere=sphere, simulation=simulation,
+            max_scenes=None if args.force else MAX_FIT_SCENES,
+        )  # fmt: skip
     chosen = report.newton if args.method == "newton" else report.direct
     summary = _summary(args, report, chosen)
     summary["model"] = simulation.describe()

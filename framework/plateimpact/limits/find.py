@@ -109,7 +109,7 @@ def _interval(name: str, values: tuple[float, float], declared: Any) -> tuple[fl
     return start, stop
 
 
-def _steps(
+def check_steps(
     tolerance: float,
     resolution: float,
     span: tuple[float, float],
@@ -257,7 +257,7 @@ def along_speed(
     fixed = _floats("obliquities", obliquities)
     IMPACT_OBLIQUITY.check(fixed)
     span = _interval("speeds", speeds, IMPACT_SPEED)
-    _steps(tolerance, resolution, span, fixed.size, "m/s", 1.0, max_scenes)
+    check_steps(tolerance, resolution, span, fixed.size, "m/s", 1.0, max_scenes)
     (found,) = _find(
         simulation, sphere, [plate], SPEED, fixed, span, tolerance, resolution, executor
     )
@@ -284,7 +284,7 @@ def along_obliquity(
     fixed = _floats("speeds", speeds)
     IMPACT_SPEED.check(fixed)
     span = _interval("obliquities", obliquities, IMPACT_OBLIQUITY)
-    _steps(tolerance, resolution, span, fixed.size, "deg", _DEG, max_scenes)
+    check_steps(tolerance, resolution, span, fixed.size, "deg", _DEG, max_scenes)
     (found,) = _find(
         simulation, sphere, [plate], OBLIQUITY, fixed, span, tolerance, resolution, executor
     )

@@ -22,7 +22,7 @@ from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
-from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, _steps
+from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, check_steps
 from .finder import RELATIVE_FLOOR, finest_tolerance, scan_points
 from .lines import SPEED
 from .regimes import Regime, regime_codes
@@ -152,7 +152,7 @@ def outcome_maps(
             f"tolerance must be in [{floor:.3g}, {resolution:g}] m/s (from {RELATIVE_FLOOR:g} "
             f"of the fastest speed to the map's spacing), got {tolerance:g}",
         )
-    _steps(tolerance, resolution, span, rows.size, "m/s", 1.0)
+    check_steps(tolerance, resolution, span, rows.size, "m/s", 1.0)
     scans: list[BatchResult] = []
     found = _find(
         simulation, sphere, plates, SPEED, rows, span, tolerance, resolution, executor, scans
