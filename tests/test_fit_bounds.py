@@ -174,3 +174,21 @@ def test_a_fit_runs_a_chunk_at_a_time_and_keeps_no_samples_per_candidate(tmp_pat
     assert (parts.pstar, parts.pstar_stderr) == (whole.pstar, whole.pstar_stderr)
     (search,) = memos
     assert all(b.speeds.size == 0 for _, _, bands in search._memo.values() for b in bands)
+
+
+def test_more_obliquities_than_a_table_takes_are_refused_before_grouping(
+    tmp_path, no_scene, monkeypatch
+):
+    """1,001 obliquities (measured ones, each shot its own): refused from one sort of the
+    obliquities, before the shots are grouped (a millisecond a group) or any scene runs."""
+    rows = [(v, k * 0.08, "perforation") for k in range(1001) for v in (900.0, 950.0)]
+    shots = pi.Shots.from_csv(csv_of(rows, tmp_path))
+
+    def no_grouping(self):  # type: ignore[no-untyped-def]
+        raise AssertionError("the shots were grouped")
+
+    monkeypatch.setattr(pi.Shots, "groups_by_obliquity", no_grouping)
+    with pytest.raises(
+        pi.CalibrationError, match="shots at 1,001 obliquities, more than the 1,000"
+    ):
+        pi.fit_pstar_by_obliquity(shots, PLATE, **FAST)

@@ -172,3 +172,17 @@ def test_the_model_residual_speeds_run_a_chunk_at_a_time_bit_for_bit(monkeypatch
     assert max(batches[1:]) <= 3
     np.testing.assert_array_equal(parts, whole)
     assert (whole > 0).any() and (whole == 0).any()
+
+
+def test_validate_lists_ten_obliquities_and_counts_the_rest(tmp_path):
+    path = tmp_path / "shots.csv"
+    path.write_text(
+        "impact_speed_m_s,impact_obliquity_deg,perforated\n"
+        + "".join(f"{500 + k},{30 + k / 10},1\n" for k in range(12))
+    )
+    code, out, err = run_cli(["validate", str(path), "--preset", "2024-T3/1.27"])
+    assert code == 0, err
+    assert (
+        "at 30, 30.1, 30.2, 30.3, 30.4, 30.5, 30.6, 30.7, 30.8, 30.9, ... (12 obliquities) deg"
+        in out
+    )

@@ -27,6 +27,10 @@ from .pstar_search import ALPHA, PSTAR, Estimate, Search, fit_sets, fit_with_alp
 #: Fewest shots for a fit of P*, and for each range of the by-obliquity fit.
 MIN_SHOTS = 5
 MIN_RANGE_SHOTS = 3
+#: The most obliquities the by-obliquity fit takes: a row every 0.09°, finer than any
+#: obliquity is measured; more are measured obliquities that want grouping, and checking
+#: each group costs about a millisecond before anything runs.
+MAX_OBLIQUITIES = 1_000
 #: Fewest residual speeds whose scatter σ_r can be fitted.
 MIN_RESIDUALS = 5
 #: The columns of the variable-pstar plug-in's table (plateimpact_plugins.variable_pstar;
@@ -247,6 +251,13 @@ def fit_pstar_by_obliquity(
     check_finder(resolution, tolerance)
     if len(shots) < MIN_SHOTS:
         raise CalibrationError(f"P* fit: {len(shots)} shots, at least {MIN_SHOTS} needed")
+    count = np.unique(shots.impact_obliquity).size
+    if count > MAX_OBLIQUITIES:
+        raise CalibrationError(
+            f"P* by obliquity: {shots.source} has shots at {count:,} obliquities, more than "
+            f"the {MAX_OBLIQUITIES:,} a table takes (a group is the shots at exactly one "
+            "obliquity: round measured obliquities to the nominal ones first)"
+        )
     groups = shots.groups_by_obliquity()
     parts: dict[tuple[float, str], Prepared] = {}
     fitted: dict[tuple[float, str], Estimate] = {}

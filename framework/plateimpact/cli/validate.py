@@ -89,7 +89,10 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
     shots = report.shots
     model = report.model
     go_no_go = int((shots.outcome == 0).sum())
-    angles = ", ".join(f"{math.degrees(o):.6g}" for o in shots.groups_by_obliquity())
+    obliquities = np.unique(shots.impact_obliquity)  # a file may measure each shot's
+    angles = ", ".join(f"{math.degrees(o):.6g}" for o in obliquities[:LISTED])
+    if obliquities.size > LISTED:
+        angles += f", ... ({obliquities.size:,} obliquities)"
     print(
         f"{label}: {len(shots)} shots from {args.shots}"
         + (f" ({go_no_go} go/no-go)" if go_no_go else "")
