@@ -77,6 +77,9 @@ def test_the_floor_is_relative_to_the_largest_value_of_the_range():
          "--resolution: resolution must be in [0.001,"),
         (["map", "--tolerance", "1e-14", "--png", "m.png"], "[2e-10, 9.79899] m/s"),
         (["map", "--tolerance", "1e-300", "--png", "m.png"], "--tolerance: tolerance must be"),
+        (["map", "--tolerance", "inf", "--png", "m.png"], "[2e-10, 9.79899] m/s"),
+        (["limits", "--obliquities", "45", "--resolution", "nan"], "[0.01, 1950] m/s"),
+        (["limits", "--obliquities", "45", "--resolution", "inf"], "[0.01, 1950] m/s"),
     ],
 )  # fmt: skip
 def test_the_command_line_names_the_tolerance_and_its_range(argv, named, scenes_run):
