@@ -16,14 +16,13 @@ from test_output_files import assert_one_line, run_cli
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.calibration import pstar_plan, pstar_search
-from plateimpact.calibration.outcome_model import ShotLines
+from plateimpact.calibration.outcome_model import ProbabilityModel, ShotLines
 from plateimpact.errors import WorkBoundError
 from plateimpact.limits import chunked
 from plateimpact.results import Outcome
 
 PLATE = presets.plate("2024-T3/3.18")
 FAST = {"resolution": 4.0, "tolerance": 0.25}
-FAST_FLAGS = ["--rtol", "1e-6", "--resolution", "4", "--tolerance", "0.25"]
 RIC, EMB, PERF = (1 << int(o) for o in Outcome)
 
 
@@ -118,7 +117,6 @@ def test_the_estimate_is_the_scan_of_every_line_times_the_candidates():
          "impact_obliquity_deg": [r[1] for r in aluminium_rows()],
          "outcome": [r[2] for r in aluminium_rows()]}
     )  # fmt: skip
-    from plateimpact.calibration.outcome_model import ProbabilityModel
     from plateimpact.calibration.pstar import prepare
 
     prepared = prepare(shots, presets.DEFAULT_SPHERE, "outcome", ProbabilityModel())
@@ -141,12 +139,19 @@ def test_a_fit_over_its_bound_is_refused_before_any_scene(tmp_path, no_scene, by
             pi.fit_pstar(shots, PLATE, max_scenes=186 * 27, **FAST)
 
 
+#: Shots on one line (45 deg, 430-530 m/s), and a coarse finder: a fit of a few seconds.
+ONE_LINE = [(v, 45, "embedment" if v < 470 else "perforation") for v in range(430, 531, 20)]
+COARSE = {"resolution": 8.0, "tolerance": 1.0}
+
+
 def test_the_command_line_names_force_and_force_lifts_the_bound(tmp_path, monkeypatch):
-    path = csv_of(aluminium_rows(), tmp_path)
-    monkeypatch.setattr("plateimpact.cli.calibrate_pstar.MAX_FIT_SCENES", 1000)
-    argv = ["calibrate", path, "--fit", "pstar", "--preset", "2024-T3/3.18", *FAST_FLAGS]
+    """One line, 350-610 m/s at 8 m/s: 33 intervals, 34 samples, x 27 candidates."""
+    path = csv_of(ONE_LINE, tmp_path)
+    monkeypatch.setattr("plateimpact.cli.calibrate_pstar.MAX_FIT_SCENES", 900)
+    argv = ["calibrate", path, "--fit", "pstar", "--preset", "2024-T3/3.18", "--rtol", "1e-6",
+            "--resolution", "8", "--tolerance", "1"]  # fmt: skip
     code, _, err = run_cli(argv)
-    assert_one_line(code, err, "P* fit: about 5,022 scenes", "more than 1,000", "--force")
+    assert_one_line(code, err, "P* fit: about 918 scenes", "more than 900", "--force")
     code, out, err = run_cli([*argv, "--force"])
     assert code == 0 and "P* = " in out, err
 
@@ -154,12 +159,22 @@ def test_the_command_line_names_force_and_force_lifts_the_bound(tmp_path, monkey
 def test_a_fit_runs_a_chunk_at_a_time_and_keeps_no_samples_per_candidate(tmp_path, monkeypatch):
     """Chunks of 100 scenes: no batch larger, the progress bar told after every chunk,
     the same P* to the last bit; the memo of every candidate holds band edges only."""
-    rows = [(v, 45, "embedment" if v < 470 else "perforation") for v in range(430, 531, 20)]
-    shots = pi.Shots.from_csv(csv_of(rows, tmp_path))  # one line: 71 samples a candidate
+    shots = pi.Shots.from_columns(  # 34 samples a candidate; residual speeds, so that
+        {  # the likelihood reads the bands' samples
+            "impact_speed_m_s": [v for v, _, _ in ONE_LINE],
+            "impact_obliquity_deg": [o for _, o, _ in ONE_LINE],
+            "outcome": [outcome for _, _, outcome in ONE_LINE],
+            "residual_speed_m_s": [0.0 if v < 470 else (v - 460) * 2.0 for v, _, _ in ONE_LINE],
+        }
+    )
     simulation = pi.Simulation.from_names(integrator_settings={"rtol": 1e-6})
-    whole = pi.fit_pstar(shots, PLATE, simulation=simulation, **FAST)
+    model = ProbabilityModel(10.0, residual_sigma=5.0)
     told: list[int] = []
     monkeypatch.setattr("plateimpact.simulation.report_scenes", told.append)
+    whole = pi.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
+    assert whole.residual_shots == 4
+    assert max(told) == 17 * 34  # the scan of 17 candidates, one batch
+    told.clear()
     monkeypatch.setattr(chunked, "RUN_CHUNK", 100)
     memos: list[pstar_search.Search] = []
     original = pstar_search.Search.__init__
@@ -169,10 +184,19 @@ def test_a_fit_runs_a_chunk_at_a_time_and_keeps_no_samples_per_candidate(tmp_pat
         memos.append(self)
 
     monkeypatch.setattr(pstar_search.Search, "__init__", remember)
-    parts = pi.fit_pstar(shots, PLATE, simulation=simulation, **FAST)
-    assert max(told) <= 100 and len(told) > 27
+    samples: list[int] = []  # what the likelihood was given
+    likelihood = pstar_search.log_likelihood
+
+    def counting(shots, bands, model):  # type: ignore[no-untyped-def]
+        samples.append(max(b.speeds.size for b in bands))
+        return likelihood(shots, bands, model)
+
+    monkeypatch.setattr(pstar_search, "log_likelihood", counting)
+    parts = pi.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
+    assert max(told) == 100 and told[:6] == [100] * 5 + [78]  # the scan, chunked
     assert (parts.pstar, parts.pstar_stderr) == (whole.pstar, whole.pstar_stderr)
-    (search,) = memos
+    (search,) = memos  # the samples served the likelihood and were dropped
+    assert max(samples) > 0
     assert all(b.speeds.size == 0 for _, _, bands in search._memo.values() for b in bands)
 
 
