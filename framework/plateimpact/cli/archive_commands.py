@@ -148,6 +148,8 @@ def study_collection(name: str) -> Any:
 
 
 def reproduce_command(args: argparse.Namespace) -> None:
+    from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
+
     reproduce = study_collection("report")
     out = Path(args.out)
     if not str(args.out).strip():
@@ -162,6 +164,11 @@ def reproduce_command(args: argparse.Namespace) -> None:
         archive, figures = reproduce(
             out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format
         )
+    except StaleRunError as exc:  # neither kept nor replaced unasked: say how to proceed
+        raise UsageError(
+            f"{exc.what}; --overwrite replaces it, --as TAG stores the new runs as "
+            "VARIANT@TAG (and the maps as map_PLATE@TAG)"
+        ) from None
     except RunExistsError as exc:
         raise UsageError(
             f"{str(exc).split(':', 1)[0]}: --resume keeps it (runs only what is missing), "
@@ -187,6 +194,8 @@ def _study_results(archive: Archive, runs: list[str]) -> StudyResults:
 
 
 def show_command(args: argparse.Namespace) -> None:
+    from ..storage.code_provenance import summary as code_lines  # noqa: PLC0415
+
     archive = Archive(args.archive)
     for name in archive.runs():
         meta: dict[str, Any] = archive.metadata(name)
@@ -195,6 +204,8 @@ def show_command(args: argparse.Namespace) -> None:
         print(f"{name}")
         for line in run_lines(meta):
             print(line)
+        for line in code_lines(meta.get("plugins")):  # each plug-in's origin and source hash
+            print(f"  {line}")
         study = archive.study(name.split("/", 1)[0])
         print(scene_line(study.scenes, study.plate_labels))
         print(

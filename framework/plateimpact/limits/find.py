@@ -23,6 +23,7 @@ from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
+from ..storage.code_provenance import limits_record, plugins_record
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import source_commit, versions
 from .chunked import run_chunked
@@ -49,7 +50,9 @@ class Limits:
     ``resolution`` are in its SI unit (m/s or rad); ``model`` is the simulation's
     plug-ins and settings; ``scenes`` how many scenes the finder ran, ``passes`` its
     refinement passes, ``seconds`` the wall time (for plates found together, the
-    request's: see :func:`~plateimpact.limits.outcome_maps`).
+    request's: see :func:`~plateimpact.limits.outcome_maps`); ``plugins`` the code
+    that found them (storage.code_provenance; None if read from a record made before
+    it was recorded).
     """
 
     axis: str
@@ -62,6 +65,7 @@ class Limits:
     scenes: int
     passes: int
     seconds: float
+    plugins: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
         """One object in user units (``plateimpact limits --json``)."""
@@ -81,6 +85,7 @@ class Limits:
             "scenes": self.scenes,
             "versions": versions(),
             "source_commit": source_commit(),
+            "plugins": self.plugins,
         }
 
 
@@ -216,6 +221,7 @@ def _find(
         first = Regime.of_code(int(found.first[i]))
         lines.append(LimitLine(axis, float(value), span[0], span[1], boundaries, first))
     model = simulation.describe()
+    plugins = {**plugins_record(simulation), "limits": limits_record()}
     n = fixed.size
     return [
         Limits(
@@ -229,6 +235,7 @@ def _find(
             found.scenes,
             found.passes,
             seconds,
+            plugins,
         )  # fmt: skip
         for k, plate in enumerate(plates)
     ]

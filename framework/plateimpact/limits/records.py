@@ -25,6 +25,7 @@ from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import git_commit, versions
 from ..storage.records import Column, Record
+from ..storage.untrusted import load_json
 from .find import Limits
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
@@ -136,6 +137,8 @@ def to_record(found: Limits | OutcomeMap) -> Record:
         "wall_time_s": float(limits.seconds),
         "regimes": json.dumps({str(r.code): r.label for r in REGIMES}),
     }
+    if limits.plugins is not None:  # the code that found them (docs/archive.md, Provenance)
+        attributes["plugins"] = json.dumps(limits.plugins, sort_keys=True)
     columns = _body_columns(limits.sphere, limits.plate) | _axis_columns(limits)
     if isinstance(found, OutcomeMap):
         columns |= {
@@ -150,6 +153,16 @@ def to_record(found: Limits | OutcomeMap) -> Record:
                                          "rows: obliquities, columns: speeds"),
         }  # fmt: skip
     return Record(attributes, columns)
+
+
+def _plugins(attributes: dict[str, object]) -> dict[str, Any] | None:
+    """The recorded ``plugins`` (None in records made before they were recorded)."""
+    if "plugins" not in attributes:
+        return None
+    found = load_json(str(attributes["plugins"]), "attribute plugins", ArchiveError)
+    if not isinstance(found, dict):
+        raise TypeError(f"attribute plugins is {type(found).__name__}, not an object")
+    return found
 
 
 def _number(attributes: dict[str, object], key: str) -> float:
@@ -204,6 +217,7 @@ def from_record(record: Record) -> Limits | OutcomeMap:
         int(_number(attributes, "scenes")),
         int(_number(attributes, "passes")),
         _number(attributes, "wall_time_s"),
+        _plugins(attributes),
     )
     if kind == KIND_LIMITS:
         return limits
@@ -267,6 +281,6 @@ def attributes_of(archive: Archive | str | os.PathLike[str], name: str) -> dict[
     """The stored attributes of ``name`` (checked), JSON ones decoded: for listings."""
     out: dict[str, Any] = {}
     for key, value in _archive(archive).record(name).attributes.items():
-        decode = key in ("plate", "model", "versions", "regimes")
+        decode = key in ("plate", "model", "versions", "regimes", "plugins")
         out[key] = json.loads(str(value)) if decode else value
     return out

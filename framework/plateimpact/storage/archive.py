@@ -307,7 +307,7 @@ class Archive(ArchiveFiles):
         for key, value in attributes.items():
             if key in ("Conventions", "study", "run"):  # a data file's own labels
                 continue
-            if key in ("variant", "model", "versions", "failure_state_units"):
+            if key in ("variant", "model", "versions", "failure_state_units", "plugins"):
                 value = json.loads(str(value))
             out[key] = value
         return out
