@@ -17,6 +17,7 @@ import contextlib
 import errno
 import glob
 import os
+import re
 import stat
 import tempfile
 from collections.abc import Callable, Iterable
@@ -172,13 +173,26 @@ def pid_alive(pid: int) -> bool:
     return True
 
 
+def temporary_owner(name: str, target: str) -> int | None:
+    """The process that made the temporary ``name`` of ``target``, if ``name`` parses
+    exactly as one (``.TARGET.PID.XXXXXXXX.tmp``, 8 characters of ``tempfile``'s or
+    hexadecimal digits); None otherwise (another file's: the temporaries of ``a`` and of
+    ``a.4194303`` both start with ``.a.``)."""
+    prefix = f".{target}."
+    if not (name.startswith(prefix) and name.endswith(".tmp")):
+        return None
+    found = re.fullmatch(r"([0-9]{1,10})\.[a-z0-9_]{8}", name[len(prefix) : -len(".tmp")])
+    return int(found.group(1)) if found else None
+
+
 def remove_dead_temporaries(target: Path) -> None:
     """Delete the temporary files of writers of ``target`` that were killed mid-write
-    (``.NAME.PID.XXXX.tmp`` whose process is gone)."""
+    (``.NAME.PID.XXXX.tmp`` whose process is gone; regular files only, never a link)."""
     for temporary in target.parent.glob(f".{glob.escape(target.name)}.*.tmp"):
-        pid = temporary.name[len(target.name) + 2 :].split(".")[0]
-        if pid.isdigit() and not pid_alive(int(pid)):
-            temporary.unlink(missing_ok=True)
+        pid = temporary_owner(temporary.name, target.name)
+        if pid is not None and not pid_alive(pid) and temporary.is_file():
+            if not temporary.is_symlink():
+                temporary.unlink(missing_ok=True)
 
 
 def keep_mode(temporary: str, target: Path) -> None:
