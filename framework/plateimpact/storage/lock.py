@@ -132,8 +132,9 @@ def locked(path: Path, real: Path, lock_path: Path, wait: float) -> Iterator[Non
                         _announce(path, holder(fd))
                         announced = True
                     time.sleep(POLL)
-            os.ftruncate(fd, 0)
-            os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+            with contextlib.suppress(OSError):  # who holds it, for messages: a full disk
+                os.ftruncate(fd, 0)  # must not keep a writer from the lock it holds
+                os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
             yield
         finally:
             os.close(fd)  # releases the flock
