@@ -13,13 +13,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
 
 import attrs
 import h5py
 import numpy as np
 
 from ..errors import ArchiveError, ParameterError
-from .append import DataFiles, append_with
+from .append import append_with
+from .data_files import DataFiles
 from .hdf5 import seal, write_dataset
 
 #: The top-level group of the stored records; a study may not take its name.
@@ -104,6 +106,8 @@ def write_record(
         seal(container)
     container = f[LIMITS]
     stored, k = name, 1
+    if not isinstance(container, h5py.Group):
+        raise ArchiveError(f"archive {path}: /{LIMITS} is not a group; the archive is damaged")
     if overwrite and name in container:
         old = container.get(name, getlink=True)
         if isinstance(old, h5py.ExternalLink):
@@ -112,13 +116,14 @@ def write_record(
     while stored in container:
         k += 1
         stored = f"{name}.{k}"
-    target = files.new(f"{LIMITS}.{stored}", lambda where: write_record_file(where, record))
+    target = files.new(f"{LIMITS}.{stored}", lambda handle: write_record_file(handle, record))
     container[stored] = h5py.ExternalLink(target, "/")
     return stored
 
 
-def write_record_file(where: Path, record: Record) -> None:
-    """The record's own HDF5 file: sealed attributes at its root, then its datasets."""
+def write_record_file(where: BinaryIO, record: Record) -> None:
+    """The record's own HDF5 file (into a file object: archives write in memory): sealed
+    attributes at its root, then its datasets."""
     with h5py.File(where, "w") as group:
         for key, value in record.attributes.items():
             group.attrs[key] = value

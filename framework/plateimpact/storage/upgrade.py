@@ -12,14 +12,16 @@ from __future__ import annotations
 import functools
 import os
 from pathlib import Path
+from typing import BinaryIO
 
 import h5py
 
 from ..errors import ArchiveError
 from ..registry import default_registry
 from ..variant import Variant
-from .append import DataFiles, append_with
+from .append import append_with
 from .archive import Archive
+from .data_files import DataFiles
 from .records import LIMITS
 
 
@@ -67,7 +69,7 @@ def _copy_record(f: h5py.File, files: DataFiles, *, kept: Path, name: str) -> st
     """Link a copy of the format-1 record ``name`` (its datasets with their attributes,
     as stored) from the new index ``f``."""
 
-    def copy(where: Path) -> None:
+    def copy(where: BinaryIO) -> None:
         with h5py.File(kept, "r") as source, h5py.File(where, "w") as copied:
             group = source[f"{LIMITS}/{name}"]
             for key in group:
