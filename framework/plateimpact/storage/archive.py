@@ -73,6 +73,7 @@ class Archive(ArchiveFiles):
     def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
         super().__init__(path)
         self.wait = wait
+        self._sizes: dict[str, int] = {}  # scenes per study, by its scenes' data file
 
     # -- writing ---------------------------------------------------------------------
 
@@ -268,6 +269,19 @@ class Archive(ArchiveFiles):
                 ) from None
             return ArchivedStudy(name, batch, variants, per_scene, description)
 
+    def _study_size(self, f: h5py.File, study: str) -> int:
+        """How many scenes ``study`` has (remembered by its scenes' data file, which is
+        written once and never changed)."""
+        link = f.get(f"{study}/scenes", getlink=True)
+        key = link.filename if isinstance(link, h5py.ExternalLink) else None
+        if key is None or key not in self._sizes:
+            with self._linked(f, f"{study}/scenes") as scenes:
+                size = self._scene_count(scenes)
+            if key is None:
+                return size
+            self._sizes[key] = size
+        return self._sizes[key]
+
     def _scene_count(self, scenes: h5py.Group) -> int:
         """How many scenes the study's scenes group or file holds (its first column's
         length, read without reading the column)."""
@@ -318,8 +332,7 @@ class Archive(ArchiveFiles):
         run = self.resolve(run)
         with self._open() as f:
             one = f.attrs["format_version"] == 1
-            with self._linked(f, f"{run.split('/', 1)[0]}/scenes") as scenes:
-                size = self._scene_count(scenes)  # one result per scene of its study
+            size = self._study_size(f, run.split("/", 1)[0])  # one result per scene
             with self._linked(f, _run_path(run)) as group:
                 prefix = "results/" if one else ""
                 columns = {

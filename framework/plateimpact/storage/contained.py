@@ -15,6 +15,7 @@ a data file of the archive's own pattern (storage.confined.data_file_name).
 from __future__ import annotations
 
 import contextlib
+import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -127,18 +128,48 @@ def open_hdf5(handle: Opened, what: str) -> Iterator[h5py.File]:
         yield f
 
 
+def identity(handle: Opened) -> tuple[int, ...]:
+    """What identifies an open file's contents: its inode and the times and size of its
+    last change (an archive's files are replaced by a rename, never changed in place)."""
+    status = os.fstat(handle.fileno())
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns, status.st_ctime_ns
+
+
+def check_once(
+    f: h5py.File,
+    handle: Opened,
+    what: str,
+    checked: dict[tuple[int, ...], set[str]] | None,
+    external: Callable[[str], bool] | None = None,
+) -> set[str]:
+    """:func:`check_contained`, remembered in ``checked`` by the file's identity (a
+    command reads one index or data file many times)."""
+    key = identity(handle)
+    if checked is not None and key in checked:
+        return checked[key]
+    named = check_contained(f, what, external)
+    if checked is not None:
+        checked[key] = named
+    return named
+
+
 @contextlib.contextmanager
-def data_file(data: Path, recorded: object, what: str) -> Iterator[h5py.File]:
+def data_file(
+    data: Path,
+    recorded: object,
+    what: str,
+    checked: dict[tuple[int, ...], set[str]] | None = None,
+) -> Iterator[h5py.File]:
     """The data file an index link records (``recorded``, its file name), opened in the
     archive's own data directory ``data`` without following a link, checked to hold
-    nothing that reaches other files."""
+    nothing that reaches other files (once per file in ``checked``)."""
     name = data_file_name(recorded, what)
     with directory(data, f"{what}: the data directory") as fd:
         handle = open_regular(
             name, f"{what}: the data file {data / name}", dir_fd=fd, label=str(data / name)
         )
     with handle, open_hdf5(handle, f"{what}: the data file {data / name}") as f:
-        check_contained(f, f"{what}: the data file {data / name}")
+        check_once(f, handle, f"{what}: the data file {data / name}", checked)
         yield f
 
 

@@ -16,7 +16,7 @@ from ..errors import ArchiveError, PlateImpactError
 from ..ragged import Ragged
 from .append import FORMAT, FORMAT_VERSION, READABLE_VERSIONS
 from .confined import SLACK, Opened, check_lengths, open_regular
-from .contained import check_contained, data_file, index_link_allowed, open_hdf5
+from .contained import check_once, data_file, index_link_allowed, open_hdf5
 from .data_files import data_directory
 from .hdf5 import SEAL, digest, plain_attributes
 from .netcdf import POINT, SAMPLE
@@ -36,6 +36,7 @@ class ArchiveFiles:
         # (a name-less path, "" or "/", is refused by every method before the lock is used)
         self.lock_path = self.real.parent / f"{self.real.name or 'root'}.lock"
         self.data = data_directory(self.real) if self.real.name else self.real
+        self._checked: dict[tuple[int, ...], set[str]] = {}  # files found contained
 
     def _exists(self) -> bool:
         """Whether the index is there (a path too long to look at is an ArchiveError)."""
@@ -58,9 +59,8 @@ class ArchiveFiles:
         if self.real.is_dir():
             raise ArchiveError(f"archive {self.path} is not a file")
         what = f"archive {self.path}"
-        with self._hdf5(
-            open_regular(self.real, what, follow=True, label=str(self.path)), what
-        ) as f:
+        handle = open_regular(self.real, what, follow=True, label=str(self.path))
+        with self._hdf5(handle, what) as f:
             if f.attrs.get("format") != FORMAT:
                 raise ArchiveError(f"{self.path} is an HDF5 file but not a plateimpact archive")
             version = f.attrs.get("format_version")
@@ -70,7 +70,8 @@ class ArchiveFiles:
                     f"plateimpact reads versions {', '.join(map(str, READABLE_VERSIONS))} and "
                     f"writes version {FORMAT_VERSION}"
                 )
-            check_contained(f, what, index_link_allowed if version == FORMAT_VERSION else None)
+            links = index_link_allowed if version == FORMAT_VERSION else None
+            check_once(f, handle, what, self._checked, links)
             yield f
 
     @contextlib.contextmanager
@@ -107,7 +108,7 @@ class ArchiveFiles:
             yield found
             return
         what = f"archive {self.path}: {printable(path)}"
-        with data_file(self.data, link.filename, what) as data:
+        with data_file(self.data, link.filename, what, self._checked) as data:
             try:
                 yield data
             except PlateImpactError:
@@ -120,38 +121,36 @@ class ArchiveFiles:
     ) -> np.ndarray:
         """The dataset at ``path`` of ``group``: a dataset (of one of the dtype ``kinds``,
         and of ``shape``, if given), no larger than its file could hold, read whole."""
-        where = f"archive {self.path}: {group.file.filename}:{group.name.rstrip('/')}/{path}"
+
+        def where() -> str:
+            name = printable(f"{group.name.rstrip('/')}/{path}", 120)
+            return f"archive {self.path}: {group.file.filename}:{name}"
+
         try:
             dataset = group.get(path)
             if not isinstance(dataset, h5py.Dataset):
-                raise ArchiveError(f"{where} is missing or not a dataset; the file is damaged")
+                raise ArchiveError(f"{where()} is missing or not a dataset; the file is damaged")
             if kinds and dataset.dtype.kind not in kinds:
                 expected = "text" if kinds == "O" else "numbers"
                 raise ArchiveError(
-                    f"{where} holds {printable(dataset.dtype, 40)} where {expected} belong; the "
-                    "file is damaged"
+                    f"{where()} holds {printable(dataset.dtype, 40)} where {expected} belong; "
+                    "the file is damaged"
                 )
             if shape is not None and dataset.shape != shape:
                 raise ArchiveError(
-                    f"{where} has shape {dataset.shape}, not {shape}; the file is damaged"
+                    f"{where()} has shape {dataset.shape}, not {shape}; the file is damaged"
                 )
-            if dataset.nbytes > group.file.id.get_filesize() + SLACK:
+            if dataset.nbytes > _file_size(dataset) + SLACK:
                 raise ArchiveError(
-                    f"{where} declares {dataset.nbytes:,} bytes, more than its file holds; the "
-                    "file is damaged"
+                    f"{where()} declares {dataset.nbytes:,} bytes, more than its file holds; "
+                    "the file is damaged"
                 )
             return np.asarray(dataset[()])
-        except (
-            OSError,
-            KeyError,
-            ValueError,
-            TypeError,
-            MemoryError,
-        ) as exc:  # memory: a damaged shape
+        except (OSError, KeyError, ValueError, TypeError, MemoryError) as exc:  # memory: a shape
             if isinstance(exc, PlateImpactError):
                 raise
             raise ArchiveError(
-                f"{where} cannot be read ({_first_line(exc)}); the file is damaged"
+                f"{where()} cannot be read ({_first_line(exc)}); the file is damaged"
             ) from None
 
     def _read_ragged(
@@ -199,6 +198,11 @@ class ArchiveFiles:
                 "(their digest does not match)"
             )
         return attributes
+
+
+def _file_size(dataset: h5py.Dataset) -> int:
+    """The size of the file holding ``dataset`` [bytes] (HDF5's end-of-file address)."""
+    return int(h5py.h5i.get_file_id(dataset.id).get_filesize())
 
 
 def _first_line(exc: BaseException) -> str:
