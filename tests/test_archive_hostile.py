@@ -479,3 +479,33 @@ def test_plate_labels_that_are_not_text_are_one_line(archive):
     _replace(archive, "w/scenes", "plate", data=np.arange(4.0))
     code, _, err = run_cli(["show", str(archive)])
     assert_one_line(code, err, "plate")
+
+
+def _top_level_dataset(f: h5py.File) -> None:
+    f["zz"] = np.arange(3)
+
+
+def _runs_a_dataset(f: h5py.File) -> None:
+    del f["w/runs"]
+    f["w/runs"] = np.arange(3)
+
+
+def _version_text(f: h5py.File) -> None:
+    f.attrs["format_version"] = "2"
+
+
+@pytest.mark.parametrize(
+    ("damage", "words"),
+    [(_top_level_dataset, "/zz is not a group"), (_runs_a_dataset, "/w/runs is not a group"),
+     (_version_text, "format version '2'")],
+)  # fmt: skip
+def test_an_index_of_another_shape_is_one_line_for_readers_and_writers(archive, result, damage,
+                                                                        words):  # fmt: skip
+    with h5py.File(archive, "a") as f:
+        damage(f)
+    before = archive.read_bytes()
+    code, _, err = run_cli(["show", str(archive)])
+    assert_one_line(code, err, words)
+    with pytest.raises(pi.ArchiveError):
+        append_run(archive, result)
+    assert archive.read_bytes() == before

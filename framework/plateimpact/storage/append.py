@@ -28,11 +28,7 @@ from ..parameters import Parameter
 from ..registry import default_registry
 from ..results import BatchResult
 from ..variant import Variant
-from .confined import (
-    directory,
-    fsync_fd,
-    write_file,
-)
+from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed
 from .data_files import (  # noqa: F401 (data_directory and encoded: their public home)
     DataFiles,
@@ -90,7 +86,7 @@ def open_index(image: io.BytesIO, exists: bool, real: Path) -> Iterator[tuple[h5
             version = f.attrs.get("format_version")
             if f.attrs.get("format") != FORMAT or version != FORMAT_VERSION:
                 raise ArchiveError(
-                    f"archive {real} has format version {printable(version, 20)}; this "
+                    f"archive {real} has format version {shown_version(version)}; this "
                     f"plateimpact appends to version {FORMAT_VERSION} only (plateimpact upgrade)"
                 )
         named = check_contained(f, f"archive {real}", index_link_allowed) if exists else set()

@@ -34,6 +34,8 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
+import numpy as np
+
 from ..errors import ArchiveError
 from .output import TEMPORARY_EXTRA, pid_alive, temporary_owner, umask
 from .untrusted import printable
@@ -68,6 +70,14 @@ def data_file_name(recorded: object, what: str) -> str:
             "directory; the archive is damaged or was made to reach outside itself"
         )
     return name
+
+
+def shown_version(version: object) -> str:
+    """A format version read from a file, for a message: an integer as it is, anything
+    else as its (inert, short) repr."""
+    if isinstance(version, int | np.integer) and not isinstance(version, bool):
+        return str(int(version))
+    return printable(repr(version), 40)
 
 
 def _pathconf(directory: Path, name: str, default: int) -> int:

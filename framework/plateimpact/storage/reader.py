@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ArchiveError, PlateImpactError
 from ..ragged import Ragged
 from .append import FORMAT, FORMAT_VERSION, READABLE_VERSIONS
-from .confined import SLACK, Opened, check_lengths, open_regular
+from .confined import SLACK, Opened, check_lengths, open_regular, shown_version
 from .contained import check_once, data_file, index_link_allowed, open_hdf5
 from .data_files import data_directory
 from .hdf5 import SEAL, digest, plain_attributes
@@ -66,7 +66,7 @@ class ArchiveFiles:
             version = f.attrs.get("format_version")
             if version not in READABLE_VERSIONS:
                 raise ArchiveError(
-                    f"archive {self.path} has format version {printable(version, 20)}; this "
+                    f"archive {self.path} has format version {shown_version(version)}; this "
                     f"plateimpact reads versions {', '.join(map(str, READABLE_VERSIONS))} and "
                     f"writes version {FORMAT_VERSION}"
                 )

@@ -23,6 +23,7 @@ from ..errors import ArchiveError, ParameterError
 from .append import append_with
 from .data_files import DataFiles
 from .hdf5 import seal, write_dataset
+from .untrusted import printable
 
 #: The top-level group of the stored records; a study may not take its name.
 LIMITS = "limits"
@@ -58,8 +59,23 @@ def is_container(f: h5py.File, name: str) -> bool:
 
 
 def study_names(f: h5py.File) -> list[str]:
-    """The archive's studies: its top-level groups but the records' one."""
-    return [name for name in f if not is_container(f, name)]
+    """The archive's studies: its top-level groups but the records' one (anything else
+    at the top, or a study whose runs are not a group, is damage)."""
+    names = []
+    for name in f:
+        if not isinstance(f.get(name), h5py.Group):
+            raise ArchiveError(
+                f"{f.filename}: /{printable(name, 80)} is not a group; the archive is damaged"
+            )
+        if not is_container(f, name):
+            runs = f[name].get("runs")
+            if runs is not None and not isinstance(runs, h5py.Group):
+                raise ArchiveError(
+                    f"{f.filename}: /{printable(name, 80)}/runs is not a group; the archive "
+                    "is damaged"
+                )
+            names.append(name)
+    return names
 
 
 def check_study_name(name: str, path: Path) -> None:

@@ -12,7 +12,7 @@ from pathlib import Path
 from ..errors import ArchiveError
 from . import confined, records
 from .append import FORMAT_VERSION
-from .confined import check_lengths
+from .confined import check_lengths, shown_version
 from .output import TEMPORARY_EXTRA, unwritable
 from .reader import ArchiveFiles
 from .untrusted import printable
@@ -53,12 +53,14 @@ def check_writable(archive: ArchiveFiles, study: str | None = None) -> None:
             raise ArchiveError(f"archive {archive.path} is read-only; refusing to append to it")
         with archive._open() as f:  # damaged, not an archive, another version: refused now
             version = f.attrs.get("format_version")
+            records.study_names(f)  # a group for each study, and for its runs
+            records.record_names(f)
             if version == FORMAT_VERSION and study is not None and study in f:
                 with archive._linked(f, f"{study}/scenes"):
                     pass  # its scenes are there, in this directory (a renamed archive too)
         if version != FORMAT_VERSION:
             raise ArchiveError(
-                f"archive {archive.path} has format version {printable(version, 20)}, which "
+                f"archive {archive.path} has format version {shown_version(version)}, which "
                 "this plateimpact reads but does not append to; `plateimpact upgrade "
                 f"{archive.path}` rewrites it as version {FORMAT_VERSION}"
             )
