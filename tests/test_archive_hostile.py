@@ -22,6 +22,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
+from plateimpact.cli import archive_commands
 from plateimpact.limits.records import attributes_of
 from plateimpact.storage import lock as locking
 from plateimpact.storage.output import write_text
@@ -509,3 +510,15 @@ def test_an_index_of_another_shape_is_one_line_for_readers_and_writers(archive, 
     with pytest.raises(pi.ArchiveError):
         append_run(archive, result)
     assert archive.read_bytes() == before
+
+
+def test_reproduce_refuses_a_shipped_lock_before_any_run(tmp_path, monkeypatch):
+    out = tmp_path / "report"
+    out.mkdir()
+    notes = tmp_path / "notes.txt"
+    notes.write_bytes(NOTES)
+    (out / "report.h5.lock").symlink_to(notes)
+    monkeypatch.setattr(archive_commands, "study_collection", lambda name: _no_run)
+    code, _, err = run_cli(["reproduce", "--out", str(out)])
+    assert_one_line(code, err, "--out", "report.h5.lock", "symbolic link")
+    assert notes.read_bytes() == NOTES
