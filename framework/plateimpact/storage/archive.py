@@ -73,7 +73,6 @@ class Archive(ArchiveFiles):
     def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
         super().__init__(path)
         self.wait = wait
-        self._sizes: dict[str, int] = {}  # scenes per study, by its scenes' data file
 
     # -- writing ---------------------------------------------------------------------
 
@@ -268,30 +267,6 @@ class Archive(ArchiveFiles):
                     f"{what}: its scenes are not ones this plateimpact runs ({exc})"
                 ) from None
             return ArchivedStudy(name, batch, variants, per_scene, description)
-
-    def _study_size(self, f: h5py.File, study: str) -> int:
-        """How many scenes ``study`` has (remembered by its scenes' data file, which is
-        written once and never changed)."""
-        link = f.get(f"{study}/scenes", getlink=True)
-        key = link.filename if isinstance(link, h5py.ExternalLink) else None
-        if key is None or key not in self._sizes:
-            with self._linked(f, f"{study}/scenes") as scenes:
-                size = self._scene_count(scenes)
-            if key is None:
-                return size
-            self._sizes[key] = size
-        return self._sizes[key]
-
-    def _scene_count(self, scenes: h5py.Group) -> int:
-        """How many scenes the study's scenes group or file holds (its first column's
-        length, read without reading the column)."""
-        first = scenes.get("impact_speed")
-        if not isinstance(first, h5py.Dataset) or first.ndim != 1:
-            raise ArchiveError(
-                f"archive {self.path}: {scenes.file.filename}:{scenes.name} holds no scenes; "
-                "the file is damaged"
-            )
-        return int(first.shape[0])
 
     def recorded_variant(self, run: str) -> Variant:
         """The variant (plug-ins and settings) the run ``STUDY/RUN`` records."""

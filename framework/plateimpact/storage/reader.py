@@ -37,6 +37,7 @@ class ArchiveFiles:
         self.lock_path = self.real.parent / f"{self.real.name or 'root'}.lock"
         self.data = data_directory(self.real) if self.real.name else self.real
         self._checked: dict[tuple[int, ...], set[str]] = {}  # files found contained
+        self._sizes: dict[str, int] = {}  # scenes per study, by its scenes' data file
 
     def _exists(self) -> bool:
         """Whether the index is there (a path too long to look at is an ArchiveError)."""
@@ -115,6 +116,30 @@ class ArchiveFiles:
                 raise
             except (OSError, RuntimeError, KeyError, ValueError, TypeError, AttributeError) as exc:
                 raise ArchiveError(f"{what} is damaged: {_first_line(exc)}") from None
+
+    def _study_size(self, f: h5py.File, study: str) -> int:
+        """How many scenes ``study`` has (remembered by its scenes' data file, which is
+        written once and never changed)."""
+        link = f.get(f"{study}/scenes", getlink=True)
+        key = link.filename if isinstance(link, h5py.ExternalLink) else None
+        if key is None or key not in self._sizes:
+            with self._linked(f, f"{study}/scenes") as scenes:
+                size = self._scene_count(scenes)
+            if key is None:
+                return size
+            self._sizes[key] = size
+        return self._sizes[key]
+
+    def _scene_count(self, scenes: h5py.Group) -> int:
+        """How many scenes the study's scenes group or file holds (its first column's
+        length, read without reading the column)."""
+        first = scenes.get("impact_speed")
+        if not isinstance(first, h5py.Dataset) or first.ndim != 1:
+            raise ArchiveError(
+                f"archive {self.path}: {scenes.file.filename}:{scenes.name} holds no scenes; "
+                "the file is damaged"
+            )
+        return int(first.shape[0])
 
     def _read(
         self, group: h5py.Group, path: str, kinds: str = "", shape: tuple[int, ...] | None = None
