@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
+from ..errors import ArchiveError
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome
@@ -114,7 +115,10 @@ def _writable_archive(args: argparse.Namespace) -> Archive | None:
     if args.archive is None:
         return None
     archive = Archive(args.archive)
-    archive.check_writable()
+    try:
+        archive.check_writable()
+    except ArchiveError as exc:  # a name too long, a read-only place, a damaged archive, ...
+        raise UsageError(f"--archive: {exc}") from None
     return archive
 
 
