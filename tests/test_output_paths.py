@@ -33,7 +33,7 @@ def bad_paths(tmp_path: Path, suffix: str) -> dict[str, tuple[Path, str]]:
     return {
         "name of 300 bytes": (tmp_path / f"{LONG_NAME}{suffix}", "longer than 255 bytes"),
         "directory name of 300 bytes": (tmp_path / LONG_NAME / f"x{suffix}", "longer than"),
-        "path of 5,000 bytes": (tmp_path.joinpath(*["ab"] * 1700) / f"x{suffix}", "bytes long"),
+        "path of 5,000 bytes": (tmp_path.joinpath(*["ab"] * 1700) / f"x{suffix}", "PATH_MAX"),
         "a file as directory": (tmp_path / "a-file" / f"x{suffix}", "is not a directory"),
         "a file deeper": (tmp_path / "a-file" / "y" / f"x{suffix}", "is not a directory"),
         "a missing directory": (tmp_path / "missing" / f"x{suffix}", "does not exist"),
@@ -55,10 +55,10 @@ def test_impossible_output_paths_are_one_line_naming_the_flag(
 def test_impossible_reproduce_directories_are_one_line_before_any_work(tmp_path):
     (tmp_path / "a-file").write_text("not a directory\n")
     for out, words in [
-        (tmp_path / LONG_NAME, "longer than 255 bytes"),
-        (tmp_path.joinpath(*["ab"] * 2500), "bytes long"),
+        (tmp_path / LONG_NAME, "NAME_MAX (255)"),
+        (tmp_path.joinpath(*["ab"] * 2500), "PATH_MAX"),
         # short enough itself, too long for the archive's data files inside
-        (tmp_path.joinpath(*["ab"] * ((4000 - len(str(tmp_path))) // 3)), "for the files"),
+        (tmp_path.joinpath(*["ab"] * ((4000 - len(str(tmp_path))) // 3)), "PATH_MAX"),
         (tmp_path / "a-file", "exists and is not a directory"),
         (tmp_path / "a-file" / "report", "is not a directory"),
         (tmp_path / "missing" / "report", "does not exist"),

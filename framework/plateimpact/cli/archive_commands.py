@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
@@ -15,10 +16,12 @@ from ..discovery import (
     first_line,
     installed_entry_points,
 )
-from ..errors import PluginError
+from ..errors import ArchiveError, PluginError
 from ..progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
+from ..storage.confined import check_lengths
+from ..storage.untrusted import printable
 from ..study import Study, StudyResults
 from .common import UsageError, add_dpi_option, check_directory, output_directory, say
 from .describe import run_description
@@ -124,6 +127,8 @@ def add_parsers(sub: Any) -> None:
     p.set_defaults(command_function=plot_command)
 
 
+#: The longest name of a file or directory [bytes] (Linux, macOS and the BSDs).
+NAME_MAX = 255
 #: The entry-point group of runnable study collections; ``reproduce`` runs ``report``.
 STUDIES_GROUP = "plateimpact.studies"
 
@@ -164,10 +169,14 @@ def reproduce_command(args: argparse.Namespace) -> None:
     reproduce = study_collection("report")
     if args.out is None:  # a quick archive holds other scenes: never the full one's place
         args.out = "report-quick" if args.quick else "report"
+    out = Path(args.out)
+    if not str(args.out).strip():
+        raise UsageError("--out: give a directory name")
+    _check_out_names(out)
     if args.tag is not None and not _printable_tag(args.tag):
         raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
-    output_directory(args.out, "--out", REPRODUCE_SPARE)  # created, or one line
-    out = Path(args.out)
+    output_directory(args.out, "--out", REPRODUCE_SPARE)  # checked and created, or one line
+    _check_out_archive(out)
     try:
         # quick only when asked: a collection of an older signature still runs in full
         quick = {"quick": True} if args.quick else {}
@@ -188,6 +197,34 @@ def reproduce_command(args: argparse.Namespace) -> None:
     say(f"archive: {archive}")
     for figure in figures:
         say(f"figure:  {figure}")
+
+
+#: The archive ``reproduce`` writes in its output directory (plateimpact_studies.reproduce).
+REPORT_ARCHIVE = "report.h5"
+
+
+def _check_out_names(out: Path) -> None:
+    """--out: every name in the path within NAME_MAX, and the deepest file the archive in
+    it makes within PATH_MAX, before anything is looked at or made."""
+    for part in out.parts:
+        if len(os.fsencode(part)) > NAME_MAX:
+            raise UsageError(
+                f"--out: the name {printable(part, 40)!r} is {len(os.fsencode(part))} bytes, "
+                f"longer than NAME_MAX ({NAME_MAX})"
+            )
+    try:
+        check_lengths(out / REPORT_ARCHIVE, Path(os.path.abspath(out)) / REPORT_ARCHIVE, "--out")
+    except ArchiveError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def _check_out_archive(out: Path) -> None:
+    """Check that the archive in the output directory can be written (one line naming
+    --out otherwise: a damaged archive, a shipped lock)."""
+    try:
+        Archive(out / REPORT_ARCHIVE).check_writable()
+    except ArchiveError as exc:
+        raise UsageError(f"--out: {exc}") from None
 
 
 def _printable_tag(tag: str) -> bool:

@@ -23,8 +23,8 @@ from ..storage.output import (
     OutputError,
     check_output,
     check_path,
-    not_writable,
     shown_path,
+    unwritable,
     write_text,
 )
 from ..storage.together import Output
@@ -85,9 +85,8 @@ def output_directory(path: str, flag: str, spare: int = 0) -> Path:
         where = real.parent
         if not where.is_dir():
             raise OutputError(f"{flag}: directory {shown_path(str(where))} does not exist")
-    refused = not_writable(where)
-    if refused:
-        raise OutputError(f"{flag}: directory {shown_path(str(where))} {refused}")
+    if not os.access(where, os.W_OK | os.X_OK):
+        raise OutputError(f"{flag}: directory {shown_path(str(where))} is {unwritable(where)}")
     try:
         real.mkdir(exist_ok=True)
     except OSError as exc:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -225,7 +225,7 @@ def v50_command(args: argparse.Namespace) -> None:
 
 
 def _json(
-    args: argparse.Namespace, obliquity: float, result: Estimate | str, labels: tuple[str, ...],
+    args: argparse.Namespace, obliquity: float, result: Estimate | str, labels: Sequence[str],
     model_limits: dict[float, float | None], model: str | None,
 ) -> dict[str, Any]:  # fmt: skip
     # 30, not 29.999999999999996 after the round trip through rad

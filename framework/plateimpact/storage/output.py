@@ -18,6 +18,7 @@ import errno
 import glob
 import hashlib
 import os
+import re
 import stat
 import tempfile
 from collections.abc import Callable, Iterable
@@ -39,6 +40,9 @@ SUFFIXES: dict[str, tuple[str, ...] | None] = {
 #: meets any journal's line-art rule, and there the 8 x 25 in outcome maps of
 #: ``reproduce`` are 290 megapixels (1.8 GB, 50 s). Print wants SVG or PDF anyway.
 FIGURE_DPI = 150.0
+#: What a temporary's name adds to its target's: ``.`` and ``.PID.XXXXXXXX.tmp``, the PID
+#: up to 7 digits (Linux's largest pid_max, 2**22) [bytes].
+TEMPORARY_EXTRA = 1 + 1 + 7 + 1 + 8 + 4
 FIGURE_DPI_RANGE = (50.0, 1200.0)
 
 
@@ -71,12 +75,20 @@ def umask() -> int:
     return current
 
 
-def _path_max(directory: str) -> int:
-    """The longest path the system takes [bytes, with its terminating NUL]."""
+def path_max(directory: str | os.PathLike[str]) -> int:
+    """The longest path the system takes in ``directory`` [bytes, with its NUL]."""
     try:
-        return os.pathconf(directory if os.path.isdir(directory) else "/", "PC_PATH_MAX")
+        return os.pathconf(directory, "PC_PATH_MAX")
     except (OSError, ValueError):
         return 4096
+
+
+def unwritable(directory: str | os.PathLike[str]) -> str:
+    """Why a directory is not writable: a read-only filesystem, or its permissions."""
+    with contextlib.suppress(OSError):
+        if os.statvfs(directory).f_flag & os.ST_RDONLY:
+            return "not writable (a read-only filesystem)"
+    return "not writable"
 
 
 def shown_path(text: str, limit: int = 200) -> str:
@@ -84,35 +96,27 @@ def shown_path(text: str, limit: int = 200) -> str:
     return printable(repr(text), limit)
 
 
-def not_writable(directory: str | os.PathLike[str]) -> str | None:
-    """Why this process cannot create files in ``directory`` (None if it can)."""
-    if os.access(directory, os.W_OK | os.X_OK):
-        return None
-    with contextlib.suppress(OSError):
-        if os.statvfs(directory).f_flag & os.ST_RDONLY:
-            return "is on a read-only filesystem"
-    return "is not writable"
-
-
 def check_path(real: Path, flag: str, spare: int = 0) -> None:
     """Refuse a path the filesystem could not take: longer than PATH_MAX (less ``spare``
     bytes kept for names inside it), a name in it longer than NAME_MAX, or a name in it
     that is a file where a directory must be."""
-    limit = _path_max(str(real.parent))
+    longest = path_max("/") - 1 - spare
     size = len(os.fsencode(real))
-    if size + spare >= limit:
-        room = f" (and {spare} for the files inside)" if spare else ""
+    if size > longest:
+        room = f", {spare} kept for the files inside" if spare else ""
         raise OutputError(
-            f"{flag}: the path is {size:,} bytes long; at most {limit - 1 - spare:,} are "
-            f"taken{room}"
+            f"{flag}: the path is {size:,} bytes; at most {longest:,} are written (PATH_MAX "
+            f"{path_max('/')}{room})"
         )
     ancestor = real
     while not os.path.lexists(ancestor) and ancestor != ancestor.parent:
         ancestor = ancestor.parent
     for part in real.relative_to(ancestor).parts if ancestor != real else ():
-        longest = _name_max(str(ancestor) if os.path.isdir(ancestor) else "/")
-        if len(os.fsencode(part)) > longest:
-            raise OutputError(f"{flag}: the name {shown_path(part)} is longer than {longest} bytes")
+        most = _name_max(str(ancestor) if os.path.isdir(ancestor) else "/")
+        if len(os.fsencode(part)) > most:
+            raise OutputError(
+                f"{flag}: the name {shown_path(part, 60)} is longer than {most} bytes"
+            )
     if real != ancestor and not os.path.isdir(ancestor):
         raise OutputError(f"{flag}: {shown_path(str(ancestor))} is not a directory")
 
@@ -125,18 +129,28 @@ def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> 
         raise OutputError(f"{flag}: give a file name, got {text!r}")
     if "\0" in text:
         raise OutputError(f"{flag}: a file name cannot hold a NUL character")
+    longest = path_max("/") - 1 - TEMPORARY_EXTRA  # with its NUL, and its temporary's name
+    if len(os.fsencode(text)) > longest:
+        raise OutputError(
+            f"{flag}: the path is {len(os.fsencode(text)):,} bytes; at most {longest:,} are "
+            f"written (PATH_MAX {path_max('/')})"
+        )
     real = Path(os.path.realpath(text))
+    if len(os.fsencode(real)) > longest:
+        raise OutputError(
+            f"{flag}: the path leads to {len(os.fsencode(real)):,} bytes; at most {longest:,} "
+            f"are written (PATH_MAX {path_max('/')})"
+        )
     directory = str(real.parent)
-    check_path(real, flag)
+    check_path(real, flag, TEMPORARY_EXTRA)
     if os.path.isdir(directory) and len(real.name.encode()) > _name_max(directory):
         raise OutputError(f"{flag}: the file name is longer than {_name_max(directory)} bytes")
     if text.endswith(os.sep) or real.is_dir():
         raise OutputError(f"{flag}: {shown_path(text)} is a directory; give a file name")
     if not os.path.isdir(directory):
         raise OutputError(f"{flag}: directory {shown_path(directory)} does not exist")
-    refused = not_writable(directory)
-    if refused:
-        raise OutputError(f"{flag}: directory {shown_path(directory)} {refused}")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise OutputError(f"{flag}: directory {shown_path(directory)} is {unwritable(directory)}")
     if real.exists() or real.is_symlink():
         try:
             mode = os.stat(real).st_mode
@@ -282,13 +296,26 @@ def pid_alive(pid: int) -> bool:
     return True
 
 
+def temporary_owner(name: str, target: str) -> int | None:
+    """The process that made the temporary ``name`` of ``target``, if ``name`` parses
+    exactly as one (``.TARGET.PID.XXXXXXXX.tmp``, 8 characters of ``tempfile``'s or
+    hexadecimal digits); None otherwise (another file's: the temporaries of ``a`` and of
+    ``a.4194303`` both start with ``.a.``)."""
+    prefix = f".{target}."
+    if not (name.startswith(prefix) and name.endswith(".tmp")):
+        return None
+    found = re.fullmatch(r"([0-9]{1,10})\.[a-z0-9_]{8}", name[len(prefix) : -len(".tmp")])
+    return int(found.group(1)) if found else None
+
+
 def remove_dead_temporaries(target: Path) -> None:
     """Delete the temporary files of writers of ``target`` that were killed mid-write
-    (``.NAME.PID.XXXX.tmp`` whose process is gone)."""
+    (``.NAME.PID.XXXX.tmp`` whose process is gone; regular files only, never a link)."""
     for temporary in target.parent.glob(f".{glob.escape(target.name)}.*.tmp"):
-        pid = temporary.name[len(target.name) + 2 :].split(".")[0]
-        if pid.isdigit() and not pid_alive(int(pid)):
-            temporary.unlink(missing_ok=True)
+        pid = temporary_owner(temporary.name, target.name)
+        if pid is not None and not pid_alive(pid) and temporary.is_file():
+            if not temporary.is_symlink():
+                temporary.unlink(missing_ok=True)
 
 
 def keep_mode(temporary: str, target: Path) -> None:

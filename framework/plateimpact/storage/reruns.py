@@ -119,7 +119,7 @@ def _stored_variants(archive: Archive, study: StudyDefinition) -> dict[str, Vari
     for run in archive.runs():
         owner, name = run.split("/", 1)
         if owner == study.name:
-            found[name] = Variant.from_json(str(archive._attributes(run)["variant"]))
+            found[name] = archive.recorded_variant(run)
     return found
 
 
