@@ -310,17 +310,56 @@ def declared_settings(cls: type) -> dict[str, Parameter]:
         if declared is None:
             default = NO_DEFAULT if field.default is attrs.NOTHING else field.default
             declared = Parameter(
-                field.name, f"setting {field.name}", default=default, convert=_json_literal
+                field.name, f"setting {field.name}", default=default, convert=json_literal
             )
         settings[field.name] = declared
     return settings
 
 
-def _json_literal(value: Any) -> Any:
-    """An undeclared setting from the command line: a JSON literal, else the text."""
-    if isinstance(value, str):
+def json_literal(value: Any) -> Any:
+    """An undeclared setting given as text: a JSON literal, else the text itself. JSON
+    nested past the interpreter's recursion limit, a key given twice or NaN is a
+    one-line ParameterError, never a traceback or a key that silently wins (the command
+    line reads ``--set`` values within storage.untrusted's bounds before they get here)."""
+    if not isinstance(value, str):
+        return value
+    try:
+        return json_text(value, "setting")
+    except ParameterError:
+        if value.lstrip()[:1] in ("[", "{"):  # an array or object, never meant as text
+            raise
         try:
-            return json.loads(value)
-        except ValueError:
+            json.loads(value)
+        except json.JSONDecodeError:  # no JSON at all: the text (RK23)
             return value
-    return value
+        except (ValueError, RecursionError):
+            pass
+        raise
+
+
+def json_text(text: str, what: str) -> Any:
+    """The JSON value of ``text`` (a setting, a variant record); malformed, too deeply
+    nested, duplicate-keyed or NaN content is a one-line ParameterError naming ``what``."""
+
+    def pairs(items: list[tuple[str, Any]]) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for key, value in items:
+            if key in out:
+                raise ParameterError(what, f"{what}: key {key!r:.60} appears twice")
+            out[key] = value
+        return out
+
+    def constant(name: str) -> float:
+        if name == "NaN":
+            raise ParameterError(what, f"{what}: NaN is not a value")
+        return float(name)
+
+    try:
+        return json.loads(text, object_pairs_hook=pairs, parse_constant=constant)
+    except RecursionError:
+        raise ParameterError(what, f"{what}: JSON nested too deeply") from None
+    except ParameterError:
+        raise
+    except ValueError as exc:  # JSONDecodeError, an integer of thousands of digits
+        reason = (str(exc).splitlines() or [type(exc).__name__])[0]
+        raise ParameterError(what, f"{what}: not valid JSON: {reason!r:.80}") from None
