@@ -30,7 +30,7 @@ from plateimpact.storage.code_provenance import plugins_record
 from plateimpact.storage.output import write_text
 from plateimpact.storage.provenance import versions
 from plateimpact.storage.source_hash import module_sources, source_sha256
-from plateimpact.storage.untrusted import load_json
+from plateimpact.untrusted import load_json
 from plateimpact.v50.figure import Panel, v50_figure
 
 DATA = Path(__file__).resolve().parent / "data"

@@ -1,7 +1,7 @@
 """Text from someone else's file never acts on the terminal: names, descriptions, hosts,
 versions, plate labels and materials of an archive, a plate file's keys, a shot file's
 cells, an inputs record's label, a P* table's header. Each prints as one inert line
-(storage.untrusted.printable: new lines, escape sequences, carriage returns and
+(plateimpact.untrusted.printable: new lines, escape sequences, carriage returns and
 bidirectional overrides escaped), in ``show``, ``compare``, ``run``, ``validate``, ``v50``
 and every error message; no forged ``plateimpact: error:`` line ever starts a line.
 

@@ -213,7 +213,7 @@ def test_an_undeclared_settings_text_parsed_in_python_is_a_parameter_error(value
 @pytest.mark.parametrize(
     ("text", "words"),
     [
-        (DEEP, "nested too deeply"),
+        (DEEP, "nested more than"),
         ('{"name": "a", "name": "b"}', "appears twice"),
         ('{"name": "a", "x": 1}', "unknown key 'x'"),
         ('{"name": "a", "failure": 1}', "failure must be a plug-in name"),

@@ -11,7 +11,6 @@ say how users write them (``mm``, ``deg``).
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from typing import Any
@@ -20,6 +19,7 @@ import attrs
 import numpy as np
 
 from .errors import ParameterError
+from .untrusted import load_json
 
 #: SI units that are written differently in file keys and JSON names (``a_N_m2``).
 _KEY_UNITS = {"1": "", "N/m^2": "N_m2", "kg/m^3": "kg_m3", "m/s": "m_s"}
@@ -317,49 +317,14 @@ def declared_settings(cls: type) -> dict[str, Parameter]:
 
 
 def json_literal(value: Any) -> Any:
-    """An undeclared setting given as text: a JSON literal, else the text itself. JSON
-    nested past the interpreter's recursion limit, a key given twice or NaN is a
-    one-line ParameterError, never a traceback or a key that silently wins (the command
-    line reads ``--set`` values within storage.untrusted's bounds before they get here)."""
+    """An undeclared setting given as text: a JSON literal, else the text itself
+    (``RK23``). JSON beyond untrusted.load_json's bounds (nesting, integer digits, a key
+    given twice, NaN) is a one-line ParameterError, never a traceback or a key that
+    silently wins."""
     if not isinstance(value, str):
         return value
-    try:
-        return json_text(value, "setting")
-    except ParameterError:
-        if value.lstrip()[:1] in ("[", "{"):  # an array or object, never meant as text
-            raise
-        try:
-            json.loads(value)
-        except json.JSONDecodeError:  # no JSON at all: the text (RK23)
-            return value
-        except (ValueError, RecursionError):
-            pass
-        raise
+    return load_json(value, "setting", _setting_error, text_if_not_json=True)
 
 
-def json_text(text: str, what: str) -> Any:
-    """The JSON value of ``text`` (a setting, a variant record); malformed, too deeply
-    nested, duplicate-keyed or NaN content is a one-line ParameterError naming ``what``."""
-
-    def pairs(items: list[tuple[str, Any]]) -> dict[str, Any]:
-        out: dict[str, Any] = {}
-        for key, value in items:
-            if key in out:
-                raise ParameterError(what, f"{what}: key {key!r:.60} appears twice")
-            out[key] = value
-        return out
-
-    def constant(name: str) -> float:
-        if name == "NaN":
-            raise ParameterError(what, f"{what}: NaN is not a value")
-        return float(name)
-
-    try:
-        return json.loads(text, object_pairs_hook=pairs, parse_constant=constant)
-    except RecursionError:
-        raise ParameterError(what, f"{what}: JSON nested too deeply") from None
-    except ParameterError:
-        raise
-    except ValueError as exc:  # JSONDecodeError, an integer of thousands of digits
-        reason = (str(exc).splitlines() or [type(exc).__name__])[0]
-        raise ParameterError(what, f"{what}: not valid JSON: {reason!r:.80}") from None
+def _setting_error(message: str) -> ParameterError:
+    return ParameterError("setting", message)

@@ -11,9 +11,9 @@ import numpy as np
 
 from .errors import ParameterError
 from .model import REST_SPEED_FRACTION
-from .parameters import json_text
 from .registry import PluginRegistry
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from .untrusted import load_json
 
 
 def _json_value(value: object) -> object:
@@ -98,7 +98,7 @@ class Variant:
         """The variant of :meth:`to_json`'s text (an archive's record, which may come from
         anyone): malformed or too deeply nested JSON, a key given twice, an unknown key
         or a value of the wrong type is a one-line ParameterError."""
-        data = json_text(text, "variant")
+        data = load_json(text, "variant", _variant_error)
         if not isinstance(data, dict):
             raise ParameterError("variant", f"variant: expected a JSON object, got {data!r:.60}")
         known = {field.name for field in attrs.fields(cls)}
@@ -109,3 +109,7 @@ class Variant:
                 f"variant: unknown key {unknown[0]!r:.60} (known: {', '.join(sorted(known))})",
             )
         return cls(**data)
+
+
+def _variant_error(message: str) -> ParameterError:
+    return ParameterError("variant", message)

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from ..errors import ParameterError, PlateImpactError, PluginError
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..storage.provenance import versions
-from ..storage.untrusted import printable
+from ..untrusted import printable
 from . import (
     archive_commands,
     calibrate,

@@ -21,8 +21,8 @@ from ..progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths
-from ..storage.untrusted import printable
 from ..study import Study, StudyResults
+from ..untrusted import printable
 from .common import UsageError, add_dpi_option, check_directory, output_directory, say
 from .describe import run_description
 from .run_comparison import print_comparison

@@ -28,7 +28,7 @@ from ..storage.output import (
     write_text,
 )
 from ..storage.together import Output
-from ..storage.untrusted import printable
+from ..untrusted import printable
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -20,7 +20,7 @@ from ..parameters import Parameter
 from ..registry import KINDS, default_registry
 from ..results import BatchResult
 from ..storage.archive import Archive
-from ..storage.untrusted import printable
+from ..untrusted import printable
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.
 LISTED_VALUES = 6

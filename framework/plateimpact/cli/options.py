@@ -18,14 +18,13 @@ import attrs
 
 from .. import presets
 from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..errors import ParameterError
 from ..model import REST_SPEED_FRACTION, ImpactModel
 from ..parameters import Parameter, json_literal
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 from ..storage.plate_file import load_plate_file
-from ..storage.untrusted import load_json
+from ..untrusted import load_json
 from .common import UsageError
 
 #: The model slots ``--set`` knows besides the plug-in kinds.
@@ -148,18 +147,9 @@ def _parse(declared: Parameter, text: str, flag: str, args: argparse.Namespace) 
 
 def _literal(text: str, flag: str) -> Any:
     """The value of ``--set SLOT.NAME=TEXT`` for an undeclared setting: JSON read within
-    storage.untrusted's bounds (nesting, integer digits, duplicate keys, NaN: one line
-    naming the flag); text that is no JSON at all (``RK23``) is the text."""
-    try:
-        return load_json(text, flag, UsageError)
-    except UsageError as refused:
-        try:
-            plain = json_literal(text)
-        except ParameterError:
-            raise refused from None
-        if plain is text:
-            return text
-        raise refused from None
+    untrusted.load_json's bounds (one line naming the flag), or the text itself when it
+    is no JSON at all (``RK23``)."""
+    return load_json(text, flag, UsageError, text_if_not_json=True)
 
 
 class ModelChoice:

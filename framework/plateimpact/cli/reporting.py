@@ -21,7 +21,7 @@ from typing import Protocol, TextIO
 from ..discovery import first_line
 from ..errors import PlateImpactWarning
 from ..storage.provenance import versions
-from ..storage.untrusted import printable
+from ..untrusted import printable
 
 
 class ShowWarning(Protocol):

@@ -16,7 +16,7 @@ from typing import IO, Any
 
 from ..storage.output import streamed
 from ..storage.together import Output
-from ..storage.untrusted import load_json_file
+from ..untrusted import load_json_file
 from .common import UsageError
 
 #: The key of the sidecar that holds the CSV's SHA-256 [hex].

@@ -36,8 +36,8 @@ from ..plugin import Plugin
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
+from ..untrusted import described, load_json_file, printable
 from .plate_file import plate_from_dict
-from .untrusted import described, load_json_file, printable
 
 FORMAT = "plateimpact-inputs-1"
 #: Keys of a record that are provenance or description, not read back (``csv_sha256``:

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import PlateImpactError
-from .untrusted import printable
+from ..untrusted import printable
 
 #: What ``kind`` may end with; ``None``: any name.
 SUFFIXES: dict[str, tuple[str, ...] | None] = {

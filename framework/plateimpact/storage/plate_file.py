@@ -23,8 +23,8 @@ from ..bodies import THICKNESS, Plate
 from ..errors import ParameterError, PlateFileError
 from ..parameters import Parameter
 from ..registry import PluginRegistry, default_registry
+from ..untrusted import described, load_json_file, printable
 from .output import write_text
-from .untrusted import described, load_json_file, printable
 
 FORMAT = "plateimpact-plate-1"
 #: Keys that are not constants.

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Callable
 from typing import Any
 
-from ..errors import PlateImpactError
+from .errors import PlateImpactError
 
 #: Deepest nesting of arrays and objects accepted. Every format plateimpact reads nests
 #: at most 4 deep (an inputs record's model settings holding a P* table's rows).
@@ -54,16 +55,26 @@ def _too_deep(text: str, limit: int) -> bool:
     return False
 
 
+#: What makes the caller's error from a one-line message: an error class taking the
+#: message alone, or a function (``lambda m: ParameterError("variant", m)``).
+ErrorFactory = Callable[[str], PlateImpactError]
+
+
 def load_json(
     text: str | bytes,
     what: str,
-    error: type[PlateImpactError] = PlateImpactError,
+    error: ErrorFactory = PlateImpactError,
     *,
     max_bytes: int = MAX_BYTES,
+    text_if_not_json: bool = False,
 ) -> Any:
     """The JSON value in ``text``, read from ``what`` (named in messages: a file, an
     attribute); any malformed, oversized, too deeply nested, duplicate-keyed or NaN
-    content raises ``error`` with one line."""
+    content raises ``error`` with one line.
+
+    ``text_if_not_json``: for a value that may be JSON or plain text (``--set
+    integrator.method=RK23``): text that is no JSON at all, and does not open an array
+    or object, is returned as it is; JSON beyond the bounds is still refused."""
     if isinstance(text, bytes | bytearray):
         if len(text) > max_bytes:
             raise error(f"{what}: {len(text):,} bytes of JSON, more than the {max_bytes:,} read")
@@ -109,6 +120,9 @@ def load_json(
     except ValueError as exc:  # JSONDecodeError is one
         if isinstance(exc, PlateImpactError):
             raise
+        if text_if_not_json and isinstance(exc, json.JSONDecodeError):
+            if text.lstrip()[:1] not in ("[", "{"):
+                return text
         reason = str(exc).splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise error(f"{what}: not valid JSON: {printable(reason)}") from None
     except RecursionError:  # belt and braces: _too_deep should have caught it
@@ -121,7 +135,7 @@ def load_json(
 
 def load_json_file(
     path: str | os.PathLike[str],
-    error: type[PlateImpactError] = PlateImpactError,
+    error: ErrorFactory = PlateImpactError,
     *,
     max_bytes: int = MAX_BYTES,
 ) -> Any:
