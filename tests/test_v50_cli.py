@@ -231,3 +231,32 @@ def test_resamples_no_fit_converged_on_are_reported(capsys, monkeypatch):
     assert out["sigma_bootstrap_ci_m_s"] is None
     sigma_line = next(line for line in text.splitlines() if line.startswith("  sigma"))
     assert sigma_line.endswith("]  -")  # the profile interval, then no bootstrap one
+
+
+def test_more_fits_than_the_bound_are_refused_before_any_fit_unless_forced(
+    shots_csv, capsys, monkeypatch
+):
+    """Two obliquities with 600,000 resamples each are 1,200,002 fits: refused in one
+    line naming --bootstrap and --force before any fit (a fit would raise here)."""
+
+    def no_fit(*args, **kwargs):
+        raise AssertionError("a fit ran before the request was checked")
+
+    monkeypatch.setattr("plateimpact.cli.v50_command.fit_v50", no_fit)
+    assert main(["v50", str(shots_csv), "--by-obliquity", "--bootstrap", "600000"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "1,200,002 fits" in err and "--force" in err
+
+
+def test_the_models_limit_scan_bound_names_the_flag_v50_has(shots_csv, capsys, monkeypatch):
+    """With the scan bound lowered below what two lines need, v50 with a plate refuses in
+    one line naming --force, which it takes; with --force the limits are found."""
+    monkeypatch.setattr(pi.limits, "MAX_SCAN_SCENES", 10)
+    args = ["v50", str(shots_csv), "--by-obliquity", "--bootstrap", "0", "--preset",
+            "SAE1010/1.47"]  # fmt: skip
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--force" in err
+    assert main([*args, "--force", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert all(row["model_ballistic_limit_m_s"] is not None for row in out)

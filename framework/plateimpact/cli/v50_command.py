@@ -30,6 +30,9 @@ FIT_OPTIONS = {"confidence": "--confidence", "bootstrap": "--bootstrap", "seed":
 MIL_STD_OPTIONS = {"spread": "--spread", "count": "--count"}
 #: Panels a figure draws at most.
 MAX_PANELS = 16
+#: Fits one command makes at most unless --force: each group's, and each of its
+#: bootstrap resamples' (about 1 ms each: 10**6 is a quarter of an hour).
+MAX_FITS = 1_000_000
 Estimate = V50Fit | MilStd662F
 
 
@@ -83,6 +86,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         f"({', '.join(map(str, COUNTS))}; default the most within the span)",
     )
     p.add_argument("--json", action="store_true", help="print JSON: one object per group")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help=f"make more than {MAX_FITS:,} fits (groups x (1 + bootstrap resamples)), and "
+        f"scan more than {lim.MAX_SCAN_SCENES:,} scenes for the model's ballistic limits",
+    )
     p.add_argument(
         "--png",
         metavar="FILE",
@@ -151,6 +160,21 @@ def _groups(args: argparse.Namespace, shots: Shots) -> dict[float, Shots]:
     return groups
 
 
+def _check_fits(args: argparse.Namespace, groups: int) -> None:
+    """Refuse, before any work, more fits than MAX_FITS unless --force."""
+    if args.method == MIL_STD or args.force:
+        return
+    resamples = (
+        DEFAULT_BOOTSTRAP if args.bootstrap is None else _number(args.bootstrap, "--bootstrap", int)
+    )
+    fits = groups * (1 + max(resamples, 0))
+    if fits > MAX_FITS:
+        raise UsageError(
+            f"--bootstrap {resamples} at {groups} obliquities makes {fits:,} fits, more than "
+            f"{MAX_FITS:,}: ask for fewer resamples, or give --force"
+        )
+
+
 def _model_limits(
     args: argparse.Namespace, groups: dict[float, Shots]
 ) -> tuple[dict[float, float | None], str | None]:
@@ -178,7 +202,10 @@ def _model_limits(
     found: dict[float, float | None] = {}
     with reporting_scenes("v50"):
         for one, obliquities in by_sphere.items():
-            limits = lim.along_speed(simulation, one, plate, obliquities, span)
+            limits = lim.along_speed(
+                simulation, one, plate, obliquities, span,
+                max_scenes=None if args.force else lim.MAX_SCAN_SCENES,
+            )  # fmt: skip
             lines = zip(obliquities, limits.lines, strict=True)
             found.update({o: line.ballistic_limit for o, line in lines})
     failure = simulation.model.failure.name
@@ -191,6 +218,7 @@ def v50_command(args: argparse.Namespace) -> None:
     estimate = _estimator(args)
     shots = Shots.from_csv(args.shots)
     groups = _groups(args, shots)
+    _check_fits(args, len(groups))
     model_limits, model = _model_limits(args, groups)
     results: dict[float, Estimate | str] = {}
     for obliquity, group in groups.items():
