@@ -31,7 +31,8 @@ MIL_STD_OPTIONS = {"spread": "--spread", "count": "--count"}
 #: Panels a figure draws at most.
 MAX_PANELS = 16
 #: Fits one command makes at most unless --force: each group's, and each of its
-#: bootstrap resamples' (about 1 ms each: 10**6 is a quarter of an hour).
+#: bootstrap resamples' (0.35 ms each for 30 shots on one core, loaded: 10**6 is about
+#: six minutes).
 MAX_FITS = 1_000_000
 Estimate = V50Fit | MilStd662F
 
