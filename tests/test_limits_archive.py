@@ -20,6 +20,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
+from plateimpact.limits.records import attributes_of
 from plateimpact.storage import append as appending
 from plateimpact.storage.lock import locked
 
@@ -371,6 +372,11 @@ def test_show_lists_limits_and_maps_and_leaves_the_runs_as_they_were(
     assert "plate 2024-T3 3.18 mm" in shown and "poncelet + plugging" in shown
     assert "tolerance 0.01 m/s, resolution 10 m/s" in shown
     assert "tolerance 0.001 deg, resolution 1 deg" in shown
+    # each record's code, as recorded: the core's and each plug-in's source hash
+    recorded = attributes_of(path, "plugging")["plugins"]
+    for slot in ("core", "resistance", "failure", "integrator"):
+        digest = recorded[slot]["source_sha256"][:12]
+        assert shown.count(f"  code: {slot} ") == 3 and f", source {digest}" in shown
     lines = (*plugging.lines, *outcome_map.limits.lines)  # the map: one line per row
     for named in ("ballistic limit", "ricochet limit"):
         expected = [x for x in (getattr(line, named.replace(" ", "_")) for line in lines) if x]

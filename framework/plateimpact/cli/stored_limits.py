@@ -11,6 +11,7 @@ from ..limits.compare import user
 from ..limits.lines import OBLIQUITY, SPEED, LimitLine
 from ..limits.records import KIND_MAP, NAMES, attributes_of
 from ..storage.archive import Archive
+from ..storage.code_provenance import summary as code_summary
 from ..storage.records import LIMITS
 from .common import UsageError, say
 from .describe import seconds, shown
@@ -113,6 +114,7 @@ def show_stored(archive: Archive) -> None:
             ),
             f"  made {shown(meta.get('creation_time'))} on {shown(meta.get('host'))}, plateimpact "
             f"{shown(version)}, commit {shown(str(meta.get('git_commit'))[:12])}",
+            *(f"  {line}" for line in code_summary(meta.get("plugins"))),
         ]
         say("\n".join(lines))
 
