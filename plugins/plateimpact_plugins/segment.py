@@ -28,12 +28,22 @@ STEP = Parameter(
     "step",
     "segment duration as a fraction of Rs/Vs, the time to travel one radius at impact "
     "speed (finest documented 1e-4)",
-    # 1e-5, the finest step tested, already takes 40 s on an ordinary scene (max_seconds
-    # ends it); finer steps only add rounding to a first-order method.
+    # 1e-5, the finest step tested, would take 54,000 steps (40 s) on an ordinary scene
+    # (500 m/s at 30 deg on 2024-T3/3.18): MAX_SEGMENT_STEPS ends it; finer steps only add
+    # rounding to a first-order method.
     range=Range(1e-5, 0.1),
     default=1e-3,
     flag="--step",
 )
+
+#: The work bound in driver steps of SEGMENTS segments each, counted (never timed). The
+#: report's scenes need contact/(8 step) steps: the longest ordinary contact, 145 Rs/Vs
+#: (the 1.27-mm plate's maps, just above its ballistic limit at 78 deg), is 18,100 steps
+#: at the default step 1e-3 and the benchmark set's longest, 30 Rs/Vs, 12,444 at 3e-4;
+#: at 1e-4 contacts up to 20 Rs/Vs run (500 m/s at 30 deg: 4.3 Rs/Vs). A scene that needs
+#: more ends after about 20 s on a 2-core machine (segments cost about 0.8 ms a step
+#: there): docs/robustness.md, "work bounds".
+MAX_SEGMENT_STEPS = 25_000
 
 
 def arc(y: np.ndarray, rates: np.ndarray, dt: np.ndarray | float) -> np.ndarray:
@@ -101,7 +111,7 @@ class Segment(Integrator):
     event_samples = SEGMENTS + 1
 
     step: float = STEP.field()
-    max_steps: int = attrs.evolve(MAX_STEPS, default=2_500_000).field()
+    max_steps: int = attrs.evolve(MAX_STEPS, default=MAX_SEGMENT_STEPS).field()
     max_seconds: float = MAX_SECONDS.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
