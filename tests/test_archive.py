@@ -213,6 +213,7 @@ def test_a_live_writer_makes_others_wait_or_save_aside_and_readers_read(tmp_path
         impatient = pi.Archive(path, wait=0.0)
         with pytest.raises(pi.ArchiveError, match=f"process {holder.pid} on .*saved to ") as info:
             impatient.append_run(study, study.variants[0], results["plugging"], {"note": "x"})
+        assert "for 0 s (Archive(path, wait=SECONDS) waits longer" in str(info.value)
         side = pathlib.Path(str(info.value).rsplit("saved to ", 1)[1])
         assert side.parent == tmp_path and pi.Archive(side).runs() == ["t318/plugging"]
         assert_same(results["plugging"], pi.Archive(side).results("plugging"))

@@ -26,7 +26,7 @@ import attrs
 import h5py
 
 from ..batch import SceneBatch
-from ..errors import ArchiveError, UnknownNameError
+from ..errors import ArchiveError, ParameterError, UnknownNameError
 from ..parameters import Parameter
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 from ..variant import Variant
@@ -66,12 +66,16 @@ class Archive(ArchiveFiles):
     Every failure to open, read or write (missing directory, not HDF5, another format
     version, checksum mismatch, missing data file, read-only, busy) raises
     :class:`ArchiveError` with a one-line message. ``wait``: how long an append waits
-    for another writer [s].
+    for another writer [s] (inf: as long as it takes).
     """
 
     def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
         super().__init__(path)
-        self.wait = wait
+        if isinstance(wait, bool) or not isinstance(wait, int | float) or not wait >= 0.0:
+            raise ParameterError(
+                "wait", f"wait must be a number of seconds >= 0 (inf: no limit), got {wait!r}"
+            )
+        self.wait = float(wait)
 
     # -- writing ---------------------------------------------------------------------
 
