@@ -25,13 +25,14 @@ from .plugin import Plugin
 #: driver then uses instead of evaluating it again (branch prediction).
 StepperState = dict[str, np.ndarray]
 
-#: The work bound, counted (never timed), so that where a scene ends never depends on the
-#: machine's speed or load. 20,000 steps is at least 1e4 Rs/Vs at dopri5's largest step
-#: (0.5 Rs/Vs): 23 times what the report's figures, maps and limits need (at most 859
-#: steps, dopri5 at rtol 1e-13) and 1.7 times the longest scene of the property tests'
-#: domain (11,787: an intact plate at a = 3e7 N/m², b = 30 kg/m³, 5 km/s, 80°), while a
-#: scene that needs more (a plate that barely resists, a sphere that slides for 1e5
-#: Rs/Vs) ends after about 15 s on a 2-core machine (docs/robustness.md, "work bounds").
+#: The work bound of every built-in integrator, counted (never timed), so that where a
+#: scene ends never depends on the machine's speed or load. 20,000 steps is at least 1e4
+#: Rs/Vs at dopri5's largest step (0.5 Rs/Vs; solve_ivp's longest_phase is the same 1e4):
+#: 23 times what the report's figures, maps and limits need (at most 859 steps, dopri5 at
+#: rtol 1e-8 to 1e-13), 1.7 times the longest scene of the property tests' domain (11,836:
+#: a = 3e7 N/m², b = 30 kg/m³, 5 km/s, intact), and for the segment method contacts of
+#: 160 Rs/Vs at its default step (the longest map scene: 145). A scene that needs more
+#: ends after 15-25 s of one core (docs/robustness.md, "work bounds").
 MAX_STEPS = Parameter(
     "max_steps",
     "give up (IntegrationError) when a scene has not finished after this many steps",

@@ -28,22 +28,13 @@ STEP = Parameter(
     "step",
     "segment duration as a fraction of Rs/Vs, the time to travel one radius at impact "
     "speed (finest documented 1e-4)",
-    # 1e-5, the finest step tested, would take 54,000 steps (40 s) on an ordinary scene
-    # (500 m/s at 30 deg on 2024-T3/3.18): MAX_SEGMENT_STEPS ends it; finer steps only add
-    # rounding to a first-order method.
+    # 1e-5, the finest step tested: 500 m/s at 30 deg on 2024-T3/3.18 would need 54,000
+    # steps (40 s) there, and max_steps ends it; finer steps only add rounding to a
+    # first-order method.
     range=Range(1e-5, 0.1),
     default=1e-3,
     flag="--step",
 )
-
-#: The work bound in driver steps of SEGMENTS segments each, counted (never timed). The
-#: report's scenes need contact/(8 step) steps: the longest ordinary contact, 145 Rs/Vs
-#: (the 1.27-mm plate's maps, just above its ballistic limit at 78 deg), is 18,100 steps
-#: at the default step 1e-3 and the benchmark set's longest, 30 Rs/Vs, 12,444 at 3e-4;
-#: at 1e-4 contacts up to 20 Rs/Vs run (500 m/s at 30 deg: 4.3 Rs/Vs). A scene that needs
-#: more ends after about 20 s on a 2-core machine (segments cost about 0.8 ms a step
-#: there): docs/robustness.md, "work bounds".
-MAX_SEGMENT_STEPS = 25_000
 
 
 def arc(y: np.ndarray, rates: np.ndarray, dt: np.ndarray | float) -> np.ndarray:
@@ -101,7 +92,10 @@ class Segment(Integrator):
 
     The driver sees ``SEGMENTS`` segments as one step, sampled at every segment's end:
     the same segments, events and trajectory, with the driver's bookkeeping spread over
-    them (segments computed past an event are discarded); ``max_steps`` counts such steps.
+    them (segments computed past an event are discarded); ``max_steps`` counts such steps:
+    a contact of C Rs/Vs takes C / (8 ``step``) of them, so the default 20,000 covers 160
+    Rs/Vs at the default step (the longest of the presets' maps, 0-84 deg and 50-2000 m/s,
+    is 145) and 16 Rs/Vs at 1e-4 (docs/robustness.md, "work bounds").
     """
 
     name = "segment"
@@ -111,7 +105,7 @@ class Segment(Integrator):
     event_samples = SEGMENTS + 1
 
     step: float = STEP.field()
-    max_steps: int = attrs.evolve(MAX_STEPS, default=MAX_SEGMENT_STEPS).field()
+    max_steps: int = MAX_STEPS.field()
     max_seconds: float = MAX_SECONDS.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
