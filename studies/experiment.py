@@ -15,14 +15,22 @@ were made from.
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import math
 import time
 from pathlib import Path
+from typing import Any
 
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
+from plateimpact.errors import PlateImpactError
 from plateimpact.experiment.figure import validation_figure
+from plateimpact.storage.code_provenance import plugins_record
 from plateimpact.storage.output import write_text
+from plateimpact.storage.provenance import versions
+from plateimpact.storage.source_hash import module_sources, source_sha256
+from plateimpact.storage.untrusted import load_json
 from plateimpact.v50.figure import Panel, v50_figure
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -30,6 +38,38 @@ PLATE = "SAE1010/1.47"
 OBLIQUE = DATA / "oblique_SAE1010_1.47mm_variable_pstar.csv"
 GO_NO_GO = DATA / "gonogo_SAE1010_1.47mm.csv"
 MODELS = {"constant-pstar": "plugging", "variable-pstar": "variable-pstar"}
+#: What produced the outputs (code, shot files), beside them: a resume keeps them only
+#: while it is what would produce them now.
+PROVENANCE = "experiment_provenance.json"
+
+
+def provenance() -> dict[str, Any]:
+    """The code and data the outputs depend on: every module of plateimpact and of the
+    studies this one imports (hashed as storage.code_provenance hashes a plug-in), the
+    models' plug-ins and core, the package versions, and the shot files' SHA-256."""
+    # The tools it reaches as pi.NAME (imported on first use, so not read as imports)
+    # are roots beside it.
+    tools = [f"plateimpact.{m}" for m in ("calibration", "experiment", "v50", "storage.shots")]
+    sources = module_sources((__name__, *tools), ["plateimpact", __name__.partition(".")[0]])
+    plugins = {name: plugins_record(pi.Simulation.from_names(failure=failure))
+               for name, failure in MODELS.items()}  # fmt: skip
+    return {
+        "source_sha256": source_sha256(sources),
+        "source_modules": [name for name, _ in sources],
+        "plugins": plugins,
+        "versions": versions(),
+        "data_sha256": {
+            p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in (OBLIQUE, GO_NO_GO)
+        },  # fmt: skip
+    }
+
+
+def _recorded(path: Path) -> object:
+    """The provenance written beside the outputs, or None (none, unreadable)."""
+    try:
+        return load_json(path.read_bytes(), str(path))
+    except (OSError, PlateImpactError):
+        return None
 
 
 def outputs(out: Path, suffix: str = "png") -> list[Path]:
@@ -47,9 +87,14 @@ def experiment(
     """Draw the validation of both mild-steel models, the V50 fits beside the model's
     ballistic limits, and write the by-obliquity P* table (CSV with standard errors)
     into ``out``; returns the paths written. With ``resume``, what is there is kept
-    (it depends only on the shot files and the model)."""
+    while :data:`PROVENANCE` beside it says it was made by the code and shot files
+    that would make it now; else everything is made again (and replaced)."""
     plate, sphere = presets.plate(PLATE), presets.DEFAULT_SPHERE
     *validations, v50, table = outputs(out, suffix)
+    record, written = provenance(), out / PROVENANCE
+    resume = resume and _recorded(written) == json.loads(json.dumps(record))
+    if not resume:  # what is there is not what would be made now: forget its record first
+        written.unlink(missing_ok=True)
     shots = pi.Shots.from_csv(OBLIQUE)
     for (name, failure), path in zip(MODELS.items(), validations, strict=True):
         if resume and path.exists():
@@ -81,6 +126,7 @@ def experiment(
             shots, plate, sphere=sphere, resolution=4.0, tolerance=0.1
         )
         write_text(table, fitted.csv_text(), "table")
+    write_text(written, json.dumps(record, indent=1, sort_keys=True) + "\n", "provenance", "json")
     return outputs(out, suffix)
 
 

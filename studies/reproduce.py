@@ -16,6 +16,8 @@ import numpy as np
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
 from plateimpact.cli.common import dots_per_inch
+from plateimpact.storage.code_provenance import limits_record, plugins_record
+from plateimpact.storage.reruns import check_code
 
 try:
     from . import (
@@ -52,6 +54,25 @@ MAP_SPEEDS, MAP_SAMPLES = (50.0, 2000.0), 100
 MAP_OBLIQUITIES = np.radians(np.arange(0.0, 85.0, 2.0))
 
 
+def map_names(tag: str | None = None) -> list[str]:
+    """The names the five plates' maps are stored under: ``map_PLATE`` (``@TAG``)."""
+    marker = "" if tag is None else f"@{tag}"
+    return [f"map_{plate.replace('/', '_')}{marker}" for plate in presets.PLATES]
+
+
+def kept_maps(archive: Path, names: list[str]) -> set[str]:
+    """Those of ``names`` stored in ``archive``, which a resume keeps, each checked to
+    have been found by the code the maps would run now (StaleRunError otherwise)."""
+    if not archive.exists():
+        return set()
+    stored = set(limits.stored_limits(archive)) & set(names)
+    current = {**plugins_record(pi.Simulation.from_names()), "limits": limits_record()}
+    for name in sorted(stored):
+        recorded = pi.Archive(archive).record(name).attributes.get("plugins")
+        check_code(f"archive {archive}: limits/{name}", recorded, current)
+    return stored
+
+
 def outcome_maps(
     out: Path,
     archive: Path,
@@ -67,9 +88,8 @@ def outcome_maps(
     ``limit_curves.<suffix>`` (at ``dpi`` [dots per inch] if a raster)."""
     from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
-    marker = "" if tag is None else f"@{tag}"
-    names = [f"map_{plate.replace('/', '_')}{marker}" for plate in presets.PLATES]
-    stored = set(limits.stored_limits(archive)) if resume and archive.exists() else set()
+    names = map_names(tag)
+    stored = kept_maps(archive, names) if resume else set()
     kept = [limits.read_limits(archive, name) for name in names if name in stored]
     found = [m for m in kept if isinstance(m, limits.OutcomeMap)]
     if len(found) < len(names):
@@ -101,7 +121,9 @@ def reproduce(
     or pdf; ``dpi`` [dots per inch] for PNG). Runs already in the archive are refused
     before anything runs, unless ``resume`` (read them back, run only the missing ones),
     ``overwrite`` (replace them) or ``tag`` (store the new runs as ``VARIANT@TAG``, the
-    maps as ``map_PLATE@TAG``)."""
+    maps as ``map_PLATE@TAG``). A run or map ``resume`` would keep that other code
+    computed (a plug-in or the core changed since) is refused before anything runs
+    (``StaleRunError``)."""
     out.mkdir(parents=True, exist_ok=True)
     archive = out / ARCHIVE_NAME
     studies = [f.study() for f in FAMILIES]
@@ -109,6 +131,8 @@ def reproduce(
     for study in [*studies, craters]:  # a run that is there is refused before any runs
         names = tagged(study, tag)
         study.check_archive(archive, resume=resume, overwrite=overwrite, run_names=names)
+    if resume:  # and so is a stored map that other code found
+        kept_maps(archive, map_names(tag))
     rerun = {"resume": resume, "overwrite": overwrite, "tag": tag}
     drawing = {"dpi": dpi, "suffix": suffix}
     figures = [run_and_plot(s, out, archive, progress, **rerun, **drawing) for s in studies]

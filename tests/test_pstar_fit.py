@@ -237,8 +237,11 @@ PLATE = ["--preset", "2024-T3/3.18"]
         (["--fit", "pstar", "--by-obliquity", "--alpha-fit", *PLATE], "--alpha-fit: not with"),
         (["--fit", "pstar", "--speed-sigma", "0", *PLATE], "--speed-sigma: speed_sigma must be"),
         (["--fit", "pstar", "--residual-sigma", "nan", *PLATE], "--residual-sigma:"),
-        (["--fit", "pstar", "--tolerance", "0", *PLATE], "--tolerance: must be in"),
-        (["--fit", "pstar", "--resolution", "0.001", *PLATE], "--resolution: must be in"),
+        (["--fit", "pstar", "--tolerance", "0", *PLATE], "--tolerance: tolerance must be in"),
+        (["--fit", "pstar", "--resolution", "0.001", *PLATE], "[0.01, 100] m/s"),
+        # below one ulp of the shots' speeds: the old finder never returned
+        (["--fit", "pstar", "--tolerance", "1e-14", *PLATE], "[1e-09, 10] m/s"),
+        (["--fit", "pstar", "--by-obliquity", "--tolerance", "1e-300", *PLATE], "--tolerance: "),
         (["--fit", "pstar", "--failure", "variable-pstar", *PLATE], "does not read"),
         (["--fit", "pstar", "--pstar", "3", *PLATE], "--pstar: not with --fit pstar"),
         (["--fit", "pstar", "--set", "plate.pstar=3", *PLATE], "plate.pstar: not with --fit"),
@@ -263,17 +266,18 @@ def test_too_few_shots(tmp_path, capsys):
 
 
 def test_shots_far_from_every_boundary_do_not_identify_pstar(tmp_path, capsys):
-    """Slow ricochets at 60 deg: only a P* below about 0.7 mm makes them perforate; the
-    shots bound P* from below and say nothing more."""
+    """Slow ricochets at 60 deg, and one embedment at 30 m/s that no P* explains: only a
+    P* below about 0.7 mm makes the ricochets perforate, so the shots bound P* from below
+    and say nothing more."""
     path = tmp_path / "far.csv"
     rows = "".join(f"{v},60,ricochet\n" for v in (100, 110, 120, 130, 140, 150))
-    path.write_text("impact_speed_m_s,impact_obliquity_deg,outcome\n" + rows)
+    path.write_text("impact_speed_m_s,impact_obliquity_deg,outcome\n" + rows + "30,60,embedment\n")
     assert main(["calibrate", str(path), "--fit", "pstar", *PLATE, *FAST]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "P* not identified: the likelihood does not fall" in err
     assert "from one side only" in err
     # shots that no P* in the range moves: the likelihood is flat
-    rows = "".join(f"{v},0,embedment\n" for v in (10, 11, 12, 13, 14, 15))
+    rows = "".join(f"{v},0,embedment\n" for v in (10, 11, 12, 13, 14)) + "12,0,ricochet\n"
     path.write_text("impact_speed_m_s,impact_obliquity_deg,outcome\n" + rows)
     assert main(["calibrate", str(path), "--fit", "pstar", *PLATE, *FAST]) == 2
     assert "P* not identified: the likelihood is flat" in capsys.readouterr().err

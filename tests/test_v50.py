@@ -57,7 +57,8 @@ def test_two_speeds_fit_their_observed_shares_exactly(method):
     assert fit.v10_m_s == pytest.approx(v50 + scale * quantile(0.1), abs=1e-5)
     assert fit.v90_m_s == pytest.approx(v50 + scale * quantile(0.9), abs=1e-5)
     np.testing.assert_allclose(fit.probability([480.0, 520.0]), [0.3, 0.8], rtol=1e-6)
-    assert (fit.shots, fit.perforations) == (4, 2)  # rows of positive weight
+    # shots are rounds, 3 + 7 + 8 + 2, of which 3 + 8 perforated (main counted rows: 4, 2)
+    assert (fit.shots, fit.perforations, fit.rows) == (20, 11, 4)
 
 
 def test_a_weight_is_that_many_identical_shots():
@@ -203,6 +204,8 @@ def test_shots_no_fit_can_take_are_refused_in_one_line(speed, perforated, words)
         ({"bootstrap": -1}, "bootstrap"),
         ({"bootstrap": 2.5}, "bootstrap"),
         ({"weight": [1, 1, -1, 1, 1]}, "weight"),
+        ({"weight": [1, 1, 2e9, 1, 1]}, "weight"),  # more shots than a row can stand for
+        ({"weight": [1, 1, math.nan, 1, 1]}, "weight"),
     ],
 )
 def test_bad_options_are_parameter_errors(options, parameter):

@@ -180,3 +180,54 @@ def test_the_shipped_go_no_go_example_is_synthetic_and_centred_on_the_model():
     profile = min(nll(s) for s in np.geomspace(1.0, 1e4, 4000))
     assert 2 * (profile + fits[0].log_likelihood) < stats.chi2.ppf(0.95, 1)
     assert fits[0].v10_ci_m_s[0] is None and fits[0].v10_ci_m_s[1] is not None
+
+
+WEIGHTED = Path(__file__).resolve().parent / "data" / "v50_weighted_13_rows.csv"
+
+
+def test_weighted_rows_are_counted_as_rounds_and_the_file_main_refused_is_fitted(capsys):
+    """The 13-row file of 53 rounds (main refused it in this order, 'did not converge'):
+    --json says rounds 53 and rows 13, shots the rounds (it said 13), perforations the
+    perforating rounds; the text says both."""
+    out = run_json(capsys, WEIGHTED, "--bootstrap", "30")
+    shots = pi.Shots.from_csv(WEIGHTED)
+    fit = fit_v50(shots.impact_speed, shots.perforated, shots.weight, bootstrap=30)
+    assert (out["rounds"], out["rows"], out["shots"], out["perforations"]) == (53, 13, 53, 25)
+    assert out["v50_m_s"] == fit.v50_m_s and out["bootstrap_failed"] == 0
+    assert main(["v50", str(WEIGHTED), "--bootstrap", "0"]) == 0
+    text = capsys.readouterr().out
+    assert f"{WEIGHTED} at 0 deg: 53 shots (13 rows), 25 perforated; probit fit" in text
+    assert main(["v50", str(WEIGHTED), "--bootstrap", "20"]) == 0
+    assert "of the resamples 0 separated (sigma 0), 0 flat (no rise with speed), 0 failed" in (
+        capsys.readouterr().out
+    )
+
+
+def test_a_weight_beyond_a_billion_is_one_line_and_exit_2(tmp_path, capsys):
+    """Weights of 1e300 overflowed the bootstrap's counts (an internal error, a traceback
+    file) and the sums; refused in one line with the range."""
+    path = tmp_path / "huge.csv"
+    rows = "".join(f"{v},0,{p},1e300\n" for v, p in ((480, 0), (500, 1), (510, 0), (520, 1)))
+    path.write_text(f"{HEADER},weight\n{rows}")
+    assert main(["v50", str(path), "--bootstrap", "10"]) == 2
+    err = capsys.readouterr().err
+    assert err == "plateimpact: error: weights must be in [0, 1e+09] (the shots a row stands for)\n"
+
+
+def test_resamples_no_fit_converged_on_are_reported(capsys, monkeypatch):
+    """Every resample's fit made to fail: the text counts them failed, left out; the
+    bootstrap intervals are '-' (none), the JSON's bootstrap_failed the resamples."""
+
+    def fails(shots, link, label):
+        raise pi.V50Error(f"{label}: the {link.name} fit did not converge: injected")
+
+    monkeypatch.setattr("plateimpact.v50.bootstrap.maximum", fails)
+    assert main(["v50", str(WEIGHTED), "--bootstrap", "40"]) == 0
+    text = capsys.readouterr().out
+    out = run_json(capsys, WEIGHTED, "--bootstrap", "40")
+    failed = out["bootstrap_failed"]
+    assert failed == 40 - out["bootstrap_separated"] - out["bootstrap_flat"] > 30
+    assert f"{failed} failed (no fit converged: left out)" in text
+    assert out["sigma_bootstrap_ci_m_s"] is None
+    sigma_line = next(line for line in text.splitlines() if line.startswith("  sigma"))
+    assert sigma_line.endswith("]  -")  # the profile interval, then no bootstrap one

@@ -72,6 +72,35 @@ def distribution_name(dist: metadata.Distribution | None) -> str:
     return re.sub(r"[-_.]+", "-", name).lower() if name else ""
 
 
+def distribution_version(dist: metadata.Distribution | None) -> str:
+    """The distribution's version as its metadata says; "" if unknown."""
+    try:
+        version = dist.version if dist is not None else None
+    except Exception:  # unreadable METADATA
+        version = None
+    return version if isinstance(version, str) else ""
+
+
+@attrs.frozen
+class PluginOrigin:
+    """Where an installed plug-in class came from: the distribution (its name as its
+    metadata spells it, and version) and the entry point it was registered through,
+    ``"builtin = plateimpact_plugins"``; "" where the metadata does not say."""
+
+    distribution: str
+    version: str
+    entry_point: str
+
+    @classmethod
+    def of(cls, entry: metadata.EntryPoint) -> PluginOrigin:
+        dist = entry.dist
+        try:
+            name = dist.metadata["Name"] if dist is not None else None
+        except Exception:  # unreadable METADATA
+            name = None
+        return cls(name or "", distribution_version(dist), entry_point_label(entry))
+
+
 def installed_entry_points(group: str) -> Iterator[metadata.EntryPoint | BrokenPackage]:
     """The entry points of ``group``, each distribution once (the first on ``sys.path``,
     as importlib.metadata chooses); a distribution whose ``entry_points.txt`` declares

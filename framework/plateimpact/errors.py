@@ -26,6 +26,12 @@ class ParameterError(PlateImpactError, ValueError):
         self.parameter = parameter
 
 
+class WorkBoundError(ParameterError):
+    """A request would run more scenes than its bound, by an estimate made before any
+    scene runs. ``parameter`` names what sets the work; the message gives the estimate,
+    the bound, and how to lift it (``max_scenes=None``; ``--force`` on the command line)."""
+
+
 class UnknownNameError(PlateImpactError, LookupError):
     """A plug-in (resistance law, failure model, integrator) or preset name is unknown."""
 

@@ -8,10 +8,9 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 
@@ -22,6 +21,7 @@ from .registry import default_registry
 from .results import RESULT_FIELDS, BatchResult, Outcome
 from .storage.append import StudyDefinition
 from .storage.archive import Archive
+from .storage.data_files import encoded
 from .storage.netcdf import FLAGS, long_name, write_run_file
 
 if TYPE_CHECKING:
@@ -109,10 +109,10 @@ def study_cube(study: StudyDefinition, runs: Mapping[str, BatchResult]) -> xarra
     )
 
 
-def write_run_netcdf(archive: Archive, run: str, path: Path) -> None:
-    """Write ``run`` of ``archive`` as one netCDF-4 file at ``path`` (as the archive's
-    own data file of a run is: scenes as coordinates, CF attributes), whatever the
-    archive's format version."""
+def write_run_netcdf(archive: Archive, run: str, path: Path | BinaryIO) -> None:
+    """Write ``run`` of ``archive`` as one netCDF-4 file at ``path`` (a path or a file
+    object; as the archive's own data file of a run is: scenes as coordinates, CF
+    attributes), whatever the archive's format version."""
     run = archive.resolve(run)
     study = archive.study(run.split("/", 1)[0])
     attributes = {k: v for k, v in archive.raw_attributes(run).items()}
@@ -124,11 +124,10 @@ def write_run_netcdf(archive: Archive, run: str, path: Path) -> None:
 
 
 def netcdf_bytes(archive: Archive, run: str) -> bytes:
-    """The netCDF-4 file of :func:`write_run_netcdf`, as bytes (for an atomic writer)."""
-    with tempfile.TemporaryDirectory() as directory:
-        path = Path(directory) / "run.nc"
-        write_run_netcdf(archive, run, path)
-        return path.read_bytes()
+    """The netCDF-4 file of :func:`write_run_netcdf`, made in memory (libhdf5 writes to
+    no disk: no temporary directory that could be full), as bytes for an atomic
+    writer."""
+    return encoded(lambda handle: write_run_netcdf(archive, run, handle))
 
 
 def table_header(archive: Archive, run: str) -> list[str]:

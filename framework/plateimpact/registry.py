@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import warnings
+import weakref
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -21,6 +22,7 @@ from . import hookspecs
 from .batch import CORE_COLUMNS
 from .discovery import (
     BrokenPackage,
+    PluginOrigin,
     distribution_label,
     distribution_name,
     entry_point_label,
@@ -46,6 +48,18 @@ KINDS: dict[str, type[Plugin]] = {
     "failure": FailureModel,
     "integrator": Integrator,
 }
+
+
+#: Each installed plug-in class's origin, whichever registry loaded it (provenance reads
+#: it from the class a simulation holds). Weak: a class dropped by its module goes too.
+_ORIGINS: weakref.WeakKeyDictionary[type, PluginOrigin] = weakref.WeakKeyDictionary()
+
+
+def plugin_origin(cls: type) -> PluginOrigin | None:
+    """The distribution and entry point ``cls`` was registered through; None for a
+    class not registered from an installed package (handed to load_registry or
+    added to a registry directly)."""
+    return _ORIGINS.get(cls)
 
 
 def _flag_list(kind: str, cls: type[Plugin]) -> list[tuple[str, str]]:
@@ -167,6 +181,11 @@ class PluginRegistry:
         """Every plate constant a registered plug-in declares, by name."""
         return {name: declared for name, (declared, _) in self._constants.items()}
 
+    def origin(self, kind: str, name: str) -> PluginOrigin | None:
+        """The distribution and entry point that registered the ``name`` plug-in (see
+        :func:`plugin_origin`)."""
+        return plugin_origin(self.get(kind, name))
+
     def declared_by(self, constant: str) -> list[str]:
         """The plug-ins (``"failure plugging"``) that declare a plate constant."""
         return list(self._constants.get(constant, (None, []))[1])
@@ -255,6 +274,7 @@ def load_registry(*, entry_points: bool = True, plugins: Iterable[object] = ()) 
     manager.add_hookspecs(hookspecs)
     # pluggy's name of each installed package -> (distribution, entry point), for reports
     installed: dict[str, tuple[str, str]] = {}
+    origins: dict[str, PluginOrigin] = {}  # and where its classes come from, for provenance
     builtins: set[str] = set()  # those of plateimpact's own distribution
     broken: list[BrokenPackage] = []
     if entry_points:
@@ -275,6 +295,7 @@ def load_registry(*, entry_points: bool = True, plugins: Iterable[object] = ()) 
                 continue
             if name is not None:
                 installed[name] = where
+                origins[name] = PluginOrigin.of(entry)
                 if distribution_name(entry.dist) == hookspecs.PROJECT:
                     builtins.add(name)
     _register_given(manager, plugins)
@@ -289,7 +310,7 @@ def load_registry(*, entry_points: bool = True, plugins: Iterable[object] = ()) 
             manager.unregister(exc.plugin)
             broken.append(BrokenPackage(*installed.pop(name), first_line(_refused(exc))))
     registry = PluginRegistry()
-    broken += _run_hooks(manager, registry, installed, builtins)
+    broken += _run_hooks(manager, registry, installed, builtins, origins)
     registry._broken = tuple(broken)
     for package in broken:
         warnings.warn(
@@ -323,6 +344,7 @@ def _run_hooks(
     registry: PluginRegistry,
     installed: dict[str, tuple[str, str]],
     builtins: set[str],
+    origins: dict[str, PluginOrigin],
 ) -> list[BrokenPackage]:
     """Each package's hook, one package at a time and all or nothing; the installed
     packages that failed (the others raise PluginError)."""
@@ -348,6 +370,11 @@ def _run_hooks(
                 raise PluginError(
                     f"the plateimpact_register hook of {impl.plugin_name} failed: {first_line(exc)}"
                 ) from exc
+            continue
+        origin = origins.get(impl.plugin_name)
+        if origin is not None:
+            for kind, name in attempted:  # the latest load wins: what is installed now
+                _ORIGINS[registry.get(kind, name)] = origin
     return broken
 
 

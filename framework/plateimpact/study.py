@@ -171,13 +171,15 @@ class Study:
         resume: bool = False,
         overwrite: bool = False,
         run_names: Mapping[str, str] | None = None,
+        registry: PluginRegistry | None = None,
     ) -> None:
         """Refuse now what :meth:`run` into ``archive`` would refuse before running: an
         archive that cannot be written, a run name that is taken (without ``resume`` or
-        ``overwrite``), a study of this name with other scenes."""
+        ``overwrite``), a study of this name with other scenes, a run ``resume`` would
+        keep that other code computed (``StaleRunError``)."""
         writer = archive if isinstance(archive, Archive) else Archive(archive)
         writer.check_writable(self.name)
-        plan_runs(writer, self, run_names, resume, overwrite)
+        plan_runs(writer, self, run_names, resume, overwrite, registry)
 
     def run(
         self,
@@ -213,7 +215,11 @@ class Study:
             Finish an interrupted study: a variant whose run is already in ``archive``
             (same plug-ins and settings, same scenes, with the trajectories or craters
             asked for) is read back instead of run again. Runs are archived only when
-            finished, so an interrupted run is simply absent.
+            finished, so an interrupted run is simply absent. A stored run whose
+            recorded code (each plug-in's distribution, version and source hash, and
+            the core's) is not what the variant would run now, or that records none,
+            is refused before anything runs (``StaleRunError``: replace it with
+            ``overwrite`` or store the new run under another name).
         overwrite : bool
             Replace the stored runs of the study's variants (each atomically, when its
             new run is finished). Without ``resume`` or ``overwrite`` a run name that
@@ -228,7 +234,7 @@ class Study:
         writer = archive if isinstance(archive, Archive) or archive is None else Archive(archive)
         if writer is not None:
             writer.check_writable(self.name)
-        planned = plan_runs(writer, self, run_names, resume, overwrite)
+        planned = plan_runs(writer, self, run_names, resume, overwrite, registry)
         finished = {v: p.kept for v, p in planned.items() if p.kept is not None}
         simulations = {
             v.name: v.simulation(registry) for v in self.variants if v.name not in finished

@@ -10,11 +10,12 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ConvergenceError
+from ..errors import CalibrationError, ConvergenceError, WorkBoundError
 from ..presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
+from .pstar_plan import MAX_FIT_SCENES
 from .start import (
     check_start,
     energy_balance_start,
@@ -37,6 +38,12 @@ MAX_NEWTON_ITERATIONS = 20
 MAX_HALVINGS = 30
 #: The direct fit keeps a and b within this factor of its start.
 DIRECT_BOUND_FACTOR = 1e3
+#: The direct fit's evaluations of its residuals (and of its Jacobian) at most.
+DIRECT_EVALUATIONS = 50
+#: Scenes per normal-incidence shot a calibration runs at most, halvings aside: three
+#: per shot per Newton step (the start and MAX_NEWTON_ITERATIONS steps), one per
+#: residual and two per Jacobian evaluation of the direct fit.
+AB_SCENES_PER_SHOT = 3 * (1 + MAX_NEWTON_ITERATIONS) + 3 * DIRECT_EVALUATIONS
 
 
 @attrs.frozen(eq=False)
@@ -211,7 +218,7 @@ def direct_fit(
     simulation: Simulation | None = None,
     start: tuple[float, float] | None = None,
     step: float = DIFFERENCE_STEP,
-    max_evaluations: int = 50,
+    max_evaluations: int = DIRECT_EVALUATIONS,
     raise_on_failure: bool = True,
 ) -> Calibration:
     """a and b by least squares of the model's residual speeds [m/s] to the shots'.
@@ -329,10 +336,22 @@ def calibrate(
     *,
     sphere: Sphere = DEFAULT_SPHERE,
     simulation: Simulation | None = None,
+    max_scenes: int | None = MAX_FIT_SCENES,
 ) -> CalibrationReport:
-    """The DRI fit of ``shots`` and a, b by both methods (``plate``: T, P*, α*)."""
+    """The DRI fit of ``shots`` and a, b by both methods (``plate``: T, P*, α*).
+    :class:`~plateimpact.errors.WorkBoundError` before any scene runs if the fits could
+    run more than ``max_scenes`` scenes (AB_SCENES_PER_SHOT per normal-incidence shot;
+    None: no bound)."""
     simulation = simulation or Simulation.from_names()
     normal = normal_shots(shots)
+    scenes = len(normal) * AB_SCENES_PER_SHOT
+    if max_scenes is not None and scenes > max_scenes:
+        raise WorkBoundError(
+            "max_scenes",
+            f"a, b fit: up to {scenes:,} scenes ({len(normal):,} normal-incidence shots, "
+            f"{AB_SCENES_PER_SHOT} model runs each at most), more than {max_scenes:,}: fit "
+            "fewer shots, or lift the bound (max_scenes=None; --force)",
+        )
     return CalibrationReport(
         shots=shots,
         dri=fit_dri(normal.impact_speed, normal.residual_speed),

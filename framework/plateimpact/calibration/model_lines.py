@@ -17,10 +17,38 @@ import numpy as np
 
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
+from ..errors import ParameterError
 from ..limits import locate, regime_codes
+from ..limits.chunked import run_chunked
+from ..limits.finder import RELATIVE_FLOOR
 from ..results import Outcome
-from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
+from ..scene import IMPACT_SPEED
+from ..simulation import Simulation
 from .outcome_model import Bands, ShotLines
+
+#: The finder's tolerance [m/s]: from RELATIVE_FLOOR of the fastest speed a line can
+#: reach (what a double resolves there: limits.finder) to 10 m/s; its resolution [m/s]
+#: from the tolerance to 100 m/s.
+TOLERANCE_RANGE = (RELATIVE_FLOOR * IMPACT_SPEED.range.high, 10.0)
+MAX_RESOLUTION = 100.0
+
+
+def check_finder(resolution: float, tolerance: float) -> None:
+    """:class:`ParameterError` (``tolerance`` or ``resolution``) unless the finder's
+    settings [m/s] are in their ranges: checked before any scene runs."""
+    low, high = TOLERANCE_RANGE
+    if not (math.isfinite(tolerance) and low <= tolerance <= high):
+        raise ParameterError(
+            "tolerance",
+            f"tolerance must be in [{low:g}, {high:g}] m/s (from {RELATIVE_FLOOR:g} of the "
+            f"fastest speed, about what a double resolves there), got {tolerance:g}",
+        )
+    if not (math.isfinite(resolution) and tolerance <= resolution <= MAX_RESOLUTION):
+        raise ParameterError(
+            "resolution",
+            f"resolution must be in [{tolerance:g}, {MAX_RESOLUTION:g}] m/s (from the "
+            f"tolerance), got {resolution:g}",
+        )
 
 
 @attrs.frozen
@@ -48,6 +76,7 @@ class LineModel:
         resolution: float,
         tolerance: float,
     ) -> None:
+        check_finder(resolution, tolerance)
         self.simulation, self.sphere, self.plate = simulation, sphere, plate
         self.resolution, self.tolerance = resolution, tolerance
         self.cost = Cost()
@@ -56,36 +85,53 @@ class LineModel:
         self, sets: Sequence[ShotLines], constants: Sequence[Mapping[str, float]]
     ) -> list[list[Bands]]:
         """For each pair of a shot set and plate constants [SI] (replacing the plate's),
-        the bands of each of the set's lines, all found in the same batches."""
+        the bands of each of the set's lines, all found in the same batches. Scenes run
+        RUN_CHUNK at a time; the perforating samples are kept only for the lines of sets
+        with residual speeds (the only ones their likelihood reads)."""
         began = time.perf_counter()
         owner = np.concatenate([np.full(s.lines, k) for k, s in enumerate(sets)])
         obliquity = np.concatenate([s.obliquity for s in sets])
         radius = np.concatenate([s.radius for s in sets])
         mass = np.concatenate([s.mass for s in sets])
+        residuals = np.array([bool(np.isfinite(s.residual).any()) for s in sets])[owner]
         replaced = {name: np.array([c[name] for c in constants])[owner] for name in constants[0]}
         base = SceneBatch.grid(self.sphere, self.plate, [1.0], [0.0])
         samples: list[tuple[np.ndarray, ...]] = []
+        calls = [0]
 
         def evaluate(line: np.ndarray, x: np.ndarray) -> np.ndarray:
-            batch = base.take(np.zeros(line.size, dtype=np.int64)).with_columns(
-                impact_speed=x,
-                impact_obliquity=obliquity[line],
-                radius=radius[line],
-                mass=mass[line],
-                **{name: values[line] for name, values in replaced.items()},
-            )
-            result = self.simulation.run_batch(batch, chunk_size=DEFAULT_CHUNK_SIZE)
-            codes = regime_codes(result)
-            samples.append((line, x, codes // 2, np.asarray(result.exit_speed)))
+            def batch_of(index: np.ndarray) -> SceneBatch:
+                on = line[index]
+                return base.take(np.zeros(index.size, dtype=np.int64)).with_columns(
+                    impact_speed=x[index],
+                    impact_obliquity=obliquity[on],
+                    radius=radius[on],
+                    mass=mass[on],
+                    **{name: values[on] for name, values in replaced.items()},
+                )
+
+            codes = np.empty(x.size, dtype=np.int64)
+            for where, result in run_chunked(self.simulation, batch_of, x.size):
+                codes[where] = regime_codes(result)
+                on, found = line[where], codes[where] // 2
+                keep = residuals[on] & (found == Outcome.PERFORATION)
+                if keep.any():
+                    speed = np.asarray(result.exit_speed)[keep]
+                    samples.append((on[keep], x[where][keep], found[keep], speed))
+            calls[0] += 1
             return codes
 
         starts = np.concatenate([s.start for s in sets])
         ends = np.concatenate([s.end for s in sets])
         found = locate(evaluate, starts, ends, self.resolution, self.tolerance)
-        line, x, outcome, exit_speed = (np.concatenate(c) for c in zip(*samples, strict=True))
+        kept = [np.concatenate(c) for c in zip(*samples, strict=True)] or [np.zeros(0)] * 4
+        order = np.argsort(kept[0], kind="stable")  # by line, each line's in run order
+        line, x, outcome, exit_speed = (c[order] for c in kept)
+        lines = np.arange(owner.size + 1)
+        at_sample, at_found = np.searchsorted(line, lines), np.searchsorted(found.line, lines)
         out: list[list[Bands]] = [[] for _ in sets]
         for index in range(owner.size):
-            mine = found.line == index
+            mine = slice(at_found[index], at_found[index + 1])
             at = 0.5 * (found.low[mine] + found.high[mine])
             outcomes = np.concatenate([[found.first[index] // 2], found.above[mine] // 2])
             # a change of the plate's state alone (ricochet, then ricochet after failure)
@@ -93,13 +139,13 @@ class LineModel:
             change = outcomes[1:] != outcomes[:-1]
             outcomes = np.concatenate([outcomes[:1], outcomes[1:][change]])
             edges = np.concatenate([[-np.inf], at[change], [np.inf]])
-            on_line = line == index
+            on_line = slice(at_sample[index], at_sample[index + 1])
             out[owner[index]].append(
                 _bands(edges, outcomes, x[on_line], outcome[on_line], exit_speed[on_line])
             )
         self.cost = Cost(
             self.cost.evaluations + len(sets),
-            self.cost.batches + len(samples),
+            self.cost.batches + calls[0],
             self.cost.seconds + time.perf_counter() - began,
         )
         return out

@@ -82,10 +82,21 @@ class ShotLines:
     mass: np.ndarray
     start: np.ndarray
     end: np.ndarray
+    #: The shots of each line (indices, in order): one sort, so that a likelihood costs
+    #: the shots plus the lines, not their product.
+    members: tuple[np.ndarray, ...] = attrs.field(
+        default=attrs.Factory(lambda self: _members(self.line, self.lines), takes_self=True)
+    )
 
     @property
     def lines(self) -> int:
         return int(self.obliquity.size)
+
+
+def _members(line: np.ndarray, lines: int) -> tuple[np.ndarray, ...]:
+    order = np.argsort(line, kind="stable")
+    bounds = np.searchsorted(line[order], np.arange(lines + 1))
+    return tuple(order[bounds[k] : bounds[k + 1]] for k in range(lines))
 
 
 def _bits(*outcomes: Outcome) -> int:
@@ -123,8 +134,10 @@ def shot_lines(
     unique, line = np.unique(keys, axis=0, return_inverse=True)
     line = line.reshape(-1)
     margin = SPEED_MARGIN * speed_sigma
-    low = np.array([speed[line == k].min() for k in range(len(unique))]) - margin
-    high = np.array([speed[line == k].max() for k in range(len(unique))]) + margin
+    low, high = np.full(len(unique), np.inf), np.full(len(unique), -np.inf)
+    np.minimum.at(low, line, speed)
+    np.maximum.at(high, line, speed)
+    low, high = low - margin, high + margin
     bounds = IMPACT_SPEED.range
     return ShotLines(
         speed, line, allowed, residual, weight, unique[:, 0], unique[:, 1], unique[:, 2],
@@ -164,8 +177,7 @@ def log_likelihood(
     speeds)."""
     s = model.speed_sigma
     probability = np.empty(shots.speed.size)
-    for k, line in enumerate(bands):
-        on = shots.line == k
+    for on, line in zip(shots.members, bands, strict=True):
         # the normal mass of each band about each shot's speed; ndtr(±inf) is 1 and 0
         cdf = ndtr((line.edges[None, :] - shots.speed[on, None]) / s)
         permitted = (shots.allowed[on, None] >> line.outcomes[None, :].astype(np.int64)) & 1
@@ -205,11 +217,13 @@ def _residual_moments(
     mean = np.zeros(int(used.sum()))
     variance = np.zeros_like(mean)
     levels = (RESIDUAL_NODES - np.arange(RESIDUAL_NODES) - 0.5) / RESIDUAL_NODES
-    for k, line in enumerate(bands):
-        on = shots.line[used] == k
-        if not on.any() or math.isnan(line.ballistic_limit):
+    position = np.cumsum(used) - 1  # each used shot's place among the used
+    for members, line in zip(shots.members, bands, strict=True):
+        mine = members[used[members]]
+        if not mine.size or math.isnan(line.ballistic_limit):
             continue
-        v = shots.speed[used][on]
+        on = position[mine]
+        v = shots.speed[mine]
         tail = ndtr(np.maximum((v - line.ballistic_limit) / s, -_TAIL))  # P(u perforates)
         u = v[:, None] - s * ndtri(tail[:, None] * levels[None, :])
         g2 = np.interp(u, line.speeds, line.residual**2)

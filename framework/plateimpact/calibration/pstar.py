@@ -19,13 +19,18 @@ from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
-from .model_lines import Cost, LineModel
+from .model_lines import Cost, LineModel, check_finder
 from .outcome_model import ProbabilityModel, ShotLines, allowed_outcomes, shot_lines
+from .pstar_plan import MAX_FIT_SCENES, check_work, unfittable
 from .pstar_search import ALPHA, PSTAR, Estimate, Search, fit_sets, fit_with_alpha
 
 #: Fewest shots for a fit of P*, and for each range of the by-obliquity fit.
 MIN_SHOTS = 5
 MIN_RANGE_SHOTS = 3
+#: The most obliquities the by-obliquity fit takes: a row every 0.09°, finer than any
+#: obliquity is measured; more are measured obliquities that want grouping, and checking
+#: each group costs about a millisecond before anything runs.
+MAX_OBLIQUITIES = 1_000
 #: Fewest residual speeds whose scatter σ_r can be fitted.
 MIN_RESIDUALS = 5
 #: The columns of the variable-pstar plug-in's table (plateimpact_plugins.variable_pstar;
@@ -127,23 +132,32 @@ def fit_pstar(
     fit_alpha: bool = False,
     resolution: float = SPEED_RESOLUTION,
     tolerance: float = SPEED_TOLERANCE,
+    max_scenes: int | None = MAX_FIT_SCENES,
 ) -> PstarFit:
     """P* [m] (and α* [rad] with ``fit_alpha``) by maximum likelihood over every shot
     with weight > 0: recorded outcomes (else perforated or not) and residual speeds.
 
     ``plate`` gives a, b and α* (the start when fitted); ``resolution`` and
-    ``tolerance`` [m/s] are the boundary finder's. :class:`CalibrationError` when the
-    shots are too few or do not fix P*; :class:`ConvergenceError` when the search does
-    not converge.
+    ``tolerance`` [m/s] are the boundary finder's. Before any scene runs:
+    :class:`CalibrationError` when the shots are too few or plainly cannot fix P*
+    (:func:`~.pstar_plan.unfittable`), :class:`~plateimpact.errors.WorkBoundError` when
+    the fit would run more than about ``max_scenes`` scenes (None: no bound). After:
+    :class:`CalibrationError` when the likelihood does not fix P*,
+    :class:`ConvergenceError` when the search does not converge.
     """
     simulation = simulation or Simulation.from_names()
     model = model or ProbabilityModel()
     _check_model(simulation, fit_alpha)
+    check_finder(resolution, tolerance)
     prepared = prepare(shots, sphere, "outcome", model)
     if prepared.lines is None or prepared.shots < MIN_SHOTS:
         raise CalibrationError(
             f"P* fit: {prepared.shots} shots with weight > 0, at least {MIN_SHOTS} needed"
         )
+    reason = unfittable(prepared.lines, prepared.shots, MIN_SHOTS)
+    if reason is not None:
+        raise CalibrationError(f"P* not identified: {reason}")
+    check_work("P* fit", [prepared.lines], resolution, fit_alpha, max_scenes)
     lines = LineModel(simulation, sphere, plate, resolution, tolerance)
     search = Search(lines, [prepared.lines], model, plate.failure_angle)
     (estimate,) = fit_sets(search)
@@ -219,40 +233,84 @@ def fit_pstar_by_obliquity(
     model: ProbabilityModel | None = None,
     resolution: float = SPEED_RESOLUTION,
     tolerance: float = SPEED_TOLERANCE,
+    max_scenes: int | None = MAX_FIT_SCENES,
 ) -> PstarTableFit:
     """At each impact obliquity of ``shots``, the P* that the ricochet-range data want
     (ricochet or not) and the P* that the perforation-range data want (perforated or
     not, and residual speeds): the report's variable-P* procedure. All fits advance in
     the same batches. A range with too few shots, or whose likelihood does not fix P*,
-    takes the other range's value (the row's notes say so); an obliquity where neither
-    is fixed raises :class:`CalibrationError`."""
+    takes the other range's value (the row's notes say so). Every obliquity is checked
+    before any scene runs: those where neither range can fix P* (too few shots, or all
+    one outcome: :func:`~.pstar_plan.unfittable`) raise one :class:`CalibrationError`
+    naming the first and counting the rest, and a fit over about ``max_scenes`` scenes a
+    :class:`~plateimpact.errors.WorkBoundError`; an obliquity whose likelihoods turn out
+    to fix neither raises :class:`CalibrationError` after the fit, all of them at once."""
     simulation = simulation or Simulation.from_names()
     model = model or ProbabilityModel()
     _check_model(simulation, False)
+    check_finder(resolution, tolerance)
     if len(shots) < MIN_SHOTS:
         raise CalibrationError(f"P* fit: {len(shots)} shots, at least {MIN_SHOTS} needed")
+    count = np.unique(shots.impact_obliquity).size
+    if count > MAX_OBLIQUITIES:
+        raise CalibrationError(
+            f"P* by obliquity: {shots.source} has shots at {count:,} obliquities, more than "
+            f"the {MAX_OBLIQUITIES:,} a table takes (a group is the shots at exactly one "
+            "obliquity: round measured obliquities to the nominal ones first)"
+        )
     groups = shots.groups_by_obliquity()
     parts: dict[tuple[float, str], Prepared] = {}
     fitted: dict[tuple[float, str], Estimate] = {}
-    sets, keys = [], []
+    sets, keys, refused = [], [], []
     for obliquity, group in groups.items():
+        reasons = []
         for question in ("ricochet", "perforation"):
             prepared = prepare(group, sphere, question, model)
             parts[obliquity, question] = prepared
-            if prepared.lines is not None and prepared.shots >= MIN_RANGE_SHOTS:
+            reason = unfittable(prepared.lines, prepared.shots, MIN_RANGE_SHOTS)
+            if reason is None and prepared.lines is not None:
                 sets.append(prepared.lines)
                 keys.append((obliquity, question))
             else:
+                reasons.append(f"{question} range: {reason}")
                 fitted[obliquity, question] = Estimate(
-                    math.nan, math.nan, plate.failure_angle, identified=False,
-                    reason=f"{prepared.shots} shots, at least {MIN_RANGE_SHOTS} needed",
-                )  # fmt: skip
+                    math.nan, math.nan, plate.failure_angle, identified=False, reason=str(reason)
+                )
+        if len(reasons) == 2:
+            refused.append((obliquity, "; ".join(reasons)))
+    _refuse(refused, "")
+    check_work("P* by obliquity", sets, resolution, False, max_scenes)
     lines = LineModel(simulation, sphere, plate, resolution, tolerance)
     if sets:
         search = Search(lines, sets, model, plate.failure_angle)
         fitted.update(zip(keys, fit_sets(search), strict=True))
-    rows = [_row(obliquity, group, parts, fitted) for obliquity, group in groups.items()]
+    rows, refused = [], []
+    for obliquity, group in groups.items():
+        try:
+            rows.append(_row(obliquity, group, parts, fitted))
+        except _Unidentified as exc:
+            refused.append((obliquity, str(exc)))
+    _refuse(refused, " after the fit")
     return PstarTableFit(tuple(rows), plate.failure_angle, model, lines.cost)
+
+
+class _Unidentified(Exception):
+    """An obliquity where neither range's likelihood fixes P*."""
+
+
+def _refuse(refused: list[tuple[float, str]], when: str) -> None:
+    """One :class:`CalibrationError` line for every obliquity that cannot be fitted: the
+    first in full, then how many more and where."""
+    if not refused:
+        return
+    (first, why), rest = refused[0], refused[1:]
+    more = ""
+    if rest:
+        shown = ", ".join(f"{math.degrees(o):g}" for o, _ in rest[:10])
+        more = (
+            f" (and {len(rest)} more obliquities: {shown}{', ...' if len(rest) > 10 else ''} deg)"
+        )
+    raise CalibrationError(f"P* not identified{when} at {math.degrees(first):g} deg: {why}{more}")
 
 
 def _row(
@@ -262,11 +320,9 @@ def _row(
     fitted: dict[tuple[float, str], Estimate],
 ) -> PstarRow:
     ricochet, perforation = fitted[obliquity, "ricochet"], fitted[obliquity, "perforation"]
-    where = f"{math.degrees(obliquity):g} deg"
     if not (ricochet.identified or perforation.identified):
-        raise CalibrationError(
-            f"P* not identified at {where}: ricochet range: {ricochet.reason}; "
-            f"perforation range: {perforation.reason}"
+        raise _Unidentified(
+            f"ricochet range: {ricochet.reason}; perforation range: {perforation.reason}"
         )
     notes = [parts[obliquity, q].note for q in ("ricochet", "perforation")]
     if not ricochet.identified:

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.optimize import elementwise, minimize
 
 from ..errors import ConvergenceError
+from ..limits.finder import GROUP_SCENES, scan_intervals
 from .model_lines import Cost, LineModel
 from .outcome_model import Bands, ProbabilityModel, ShotLines, log_likelihood
 
@@ -59,6 +60,12 @@ PLATEAU = 0.5
 NEAR = 3.0
 #: The failure constants a fit sets.
 PSTAR, ALPHA = "critical_penetration", "failure_angle"
+_NONE = np.zeros(0)
+
+
+def scan_scenes(shots: ShotLines, resolution: float) -> int:
+    """The scan samples of the lines of one shot set, for one candidate."""
+    return int((scan_intervals(shots.start, shots.end, resolution) + 1).sum())
 
 
 @attrs.frozen
@@ -66,7 +73,8 @@ class Estimate:
     """What one shot set says: P* [m] and its standard error, α* [rad] (its standard
     error NaN unless fitted), their correlation, the log-likelihood at the maximum, σ_r
     [m/s] (NaN without residual speeds), the model's ``bands`` on each line there, and
-    ``near``: the shots within NEAR × s of one of them. ``identified`` is False when
+    ``near``: the shots within NEAR × s of one of them (the bands without their
+    residual-speed samples, which the likelihood alone reads). ``identified`` is False when
     the shots do not fix P*; ``reason`` says why."""
 
     pstar: float
@@ -91,6 +99,8 @@ class Search:
     ) -> None:
         self.lines, self.sets, self.model, self.alpha = lines, list(sets), model, alpha
         self.radius = float(lines.sphere.radius)
+        #: the scan samples of one candidate of each set
+        self.scan_scenes = [scan_scenes(shots, lines.resolution) for shots in self.sets]
         self._memo: dict[tuple[int, float, float], tuple[float, float, list[Bands]]] = {}
 
     @property
@@ -108,14 +118,32 @@ class Search:
         alpha = np.full(x.shape, self.alpha) if alpha is None else alpha
         keys = [(int(k), float(a), float(b)) for k, a, b in zip(index, x, alpha, strict=True)]
         new = list(dict.fromkeys(key for key in keys if key not in self._memo))
-        if new:
+        for group in self._groups(new):
             bands = self.lines.bands(
-                [self.sets[k] for k, _, _ in new], [self.constants(a, b) for _, a, b in new]
+                [self.sets[k] for k, _, _ in group], [self.constants(a, b) for _, a, b in group]
             )
-            for key, found in zip(new, bands, strict=True):
+            for key, found in zip(group, bands, strict=True):
                 value, sigma = log_likelihood(self.sets[key[0]], found, self.model)
-                self._memo[key] = (value, sigma, found)
+                # the bands' residual-speed samples served the likelihood; kept, they
+                # would grow with sets x candidates x the scan
+                self._memo[key] = (value, sigma, [attrs.evolve(b, speeds=_NONE, residual=_NONE)
+                                                  for b in found])  # fmt: skip
         return [self._memo[key] for key in keys]
+
+    def _groups(self, keys: list[tuple[int, float, float]]) -> list[list[tuple[int, float, float]]]:
+        """``keys`` in consecutive groups of at most GROUP_SCENES scan samples, each group
+        one set of batches: what a group holds is bounded, and a request that fits in
+        one group (every ordinary one) runs as before."""
+        groups: list[list[tuple[int, float, float]]] = []
+        total = GROUP_SCENES
+        for key in keys:
+            n = self.scan_scenes[key[0]]
+            if total + n > GROUP_SCENES:
+                groups.append([])
+                total = 0
+            groups[-1].append(key)
+            total += n
+        return groups
 
     def value(self, x: np.ndarray, index: np.ndarray) -> np.ndarray:
         """−log-likelihood of sets ``index`` at ``x`` (any shape), for the minimiser."""
@@ -127,8 +155,8 @@ class Search:
         """How many shots of set ``k`` lie within NEAR × s of a boundary of ``bands``."""
         shots = self.sets[k]
         count = 0
-        for line, found in enumerate(bands):
-            v = shots.speed[shots.line == line]
+        for members, found in zip(shots.members, bands, strict=True):
+            v = shots.speed[members]
             inner = found.edges[1:-1]
             if inner.size:
                 gap = np.min(np.abs(v[:, None] - inner[None, :]), axis=1)

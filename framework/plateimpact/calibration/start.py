@@ -13,6 +13,7 @@ from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
 from ..errors import CalibrationError, ShotDataError
 from ..geometry import contact_geometry
+from ..limits.chunked import run_chunked
 from ..parameters import Range
 from ..results import Outcome
 from ..simulation import Simulation
@@ -77,16 +78,31 @@ def model_residual_speeds(
     constants: Sequence[tuple[float, float]],
 ) -> np.ndarray:
     """Residual speeds [m/s] of the model at normal incidence, shape (len(constants),
-    len(impact_speeds)), for each (a [N/m²], b [kg/m³]) in ``constants``; one batch.
-    Embedments give 0."""
+    len(impact_speeds)), for each (a [N/m²], b [kg/m³]) in ``constants``; one batch,
+    run RUN_CHUNK scenes at a time. Embedments give 0."""
     speeds = np.asarray(impact_speeds, dtype=float)
-    batch = SceneBatch.concat(
-        SceneBatch.grid(sphere, plate.with_constants(a=a, b=b), speeds, np.zeros(1))
-        for a, b in constants
-    )
-    result = simulation.run_batch(batch)
-    residual = np.where(result.outcome == Outcome.PERFORATION, result.exit_speed, 0.0)
-    return residual.reshape(len(constants), speeds.size)
+    a, b = (np.array([c[k] for c in constants], dtype=float) for k in (0, 1))
+    fixed = {name: value for name, value in plate.constants if name not in ("a", "b")}
+
+    def batch_of(index: np.ndarray) -> SceneBatch:
+        k, i = np.divmod(index, speeds.size)  # constants-major, as the rows
+        return SceneBatch(
+            {
+                "radius": np.full(index.size, sphere.radius),
+                "mass": np.full(index.size, sphere.mass),
+                "thickness": np.full(index.size, plate.thickness),
+                "impact_speed": speeds[i],
+                "impact_obliquity": np.zeros(index.size),
+                "a": a[k],
+                "b": b[k],
+                **{name: np.full(index.size, value) for name, value in fixed.items()},
+            }
+        )
+
+    residual = np.empty(a.size * speeds.size)
+    for where, result in run_chunked(simulation, batch_of, residual.size):
+        residual[where] = np.where(result.outcome == Outcome.PERFORATION, result.exit_speed, 0.0)
+    return residual.reshape(a.size, speeds.size)
 
 
 def normal_shots(shots: Shots) -> Shots:

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import math
+import os
 from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
@@ -17,11 +19,13 @@ from ..discovery import (
     first_line,
     installed_entry_points,
 )
-from ..errors import PluginError
+from ..errors import ArchiveError, PluginError
 from ..progress import progress_bar
 from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
+from ..storage.confined import check_lengths
+from ..storage.untrusted import printable
 from ..study import Study, StudyResults
 from .common import UsageError, add_dpi_option, check_directory
 from .describe import run_lines, scene_line
@@ -118,6 +122,8 @@ def add_parsers(sub: Any) -> None:
     p.set_defaults(command_function=plot_command)
 
 
+#: The longest name of a file or directory [bytes] (Linux, macOS and the BSDs).
+NAME_MAX = 255
 #: The entry-point group of runnable study collections; ``reproduce`` runs ``report``.
 STUDIES_GROUP = "plateimpact.studies"
 
@@ -148,20 +154,29 @@ def study_collection(name: str) -> Any:
 
 
 def reproduce_command(args: argparse.Namespace) -> None:
+    from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
+
     reproduce = study_collection("report")
     out = Path(args.out)
     if not str(args.out).strip():
         raise UsageError("--out: give a directory name")
+    _check_out_names(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out: {args.out!r} exists and is not a directory")
     if not out.parent.resolve().is_dir():
         raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
     if args.tag is not None and not _printable_tag(args.tag):
         raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
+    _make_out(out)
     try:
         archive, figures = reproduce(
             out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format
         )
+    except StaleRunError as exc:  # neither kept nor replaced unasked: say how to proceed
+        raise UsageError(
+            f"{exc.what}; --overwrite replaces it, --as TAG stores the new runs as "
+            "VARIANT@TAG (and the maps as map_PLATE@TAG)"
+        ) from None
     except RunExistsError as exc:
         raise UsageError(
             f"{str(exc).split(':', 1)[0]}: --resume keeps it (runs only what is missing), "
@@ -170,6 +185,39 @@ def reproduce_command(args: argparse.Namespace) -> None:
     print(f"archive: {archive}")
     for figure in figures:
         print(f"figure:  {figure}")
+
+
+#: The archive ``reproduce`` writes in its output directory (plateimpact_studies.reproduce).
+REPORT_ARCHIVE = "report.h5"
+
+
+def _check_out_names(out: Path) -> None:
+    """--out: every name in the path within NAME_MAX, and the deepest file the archive in
+    it makes within PATH_MAX, before anything is looked at or made."""
+    for part in out.parts:
+        if len(os.fsencode(part)) > NAME_MAX:
+            raise UsageError(
+                f"--out: the name {printable(part, 40)!r} is {len(os.fsencode(part))} bytes, "
+                f"longer than NAME_MAX ({NAME_MAX})"
+            )
+    try:
+        check_lengths(out / REPORT_ARCHIVE, Path(os.path.abspath(out)) / REPORT_ARCHIVE, "--out")
+    except ArchiveError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def _make_out(out: Path) -> None:
+    """Make the output directory and check that its archive can be written (one line
+    naming --out otherwise: a read-only filesystem, a damaged archive, a shipped lock)."""
+    try:
+        out.mkdir(exist_ok=True)
+    except OSError as exc:
+        reason = "a read-only filesystem" if exc.errno == errno.EROFS else exc.strerror
+        raise UsageError(f"--out: cannot make the directory {out}: {reason}") from None
+    try:
+        Archive(out / REPORT_ARCHIVE).check_writable()
+    except ArchiveError as exc:
+        raise UsageError(f"--out: {exc}") from None
 
 
 def _printable_tag(tag: str) -> bool:
@@ -187,6 +235,8 @@ def _study_results(archive: Archive, runs: list[str]) -> StudyResults:
 
 
 def show_command(args: argparse.Namespace) -> None:
+    from ..storage.code_provenance import summary as code_lines  # noqa: PLC0415
+
     archive = Archive(args.archive)
     for name in archive.runs():
         meta: dict[str, Any] = archive.metadata(name)
@@ -195,6 +245,8 @@ def show_command(args: argparse.Namespace) -> None:
         print(f"{name}")
         for line in run_lines(meta):
             print(line)
+        for line in code_lines(meta.get("plugins")):  # each plug-in's origin and source hash
+            print(f"  {line}")
         study = archive.study(name.split("/", 1)[0])
         print(scene_line(study.scenes, study.plate_labels))
         print(

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..bodies import Plate, Sphere
 from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
+from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..simulation import Simulation
@@ -73,6 +74,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     p.add_argument("--png", metavar="FILE", help="draw data, DRI curve and model curves here")
     add_dpi_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help=f"run a fit estimated at more than {MAX_FIT_SCENES:,} scenes (refused unasked, "
+        "before any scene runs)",
+    )
     add_pstar_options(p)
     add_body_options(p, registry)
     add_model_options(p, registry)
@@ -97,7 +104,10 @@ def calibrate_command(args: argparse.Namespace) -> None:
     sphere, given, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given.thickness, given.constants)
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
-        report = calibrate(shots, plate, sphere=sphere, simulation=simulation)
+        report = calibrate(
+            shots, plate, sphere=sphere, simulation=simulation,
+            max_scenes=None if args.force else MAX_FIT_SCENES,
+        )  # fmt: skip
     chosen = report.newton if args.method == "newton" else report.direct
     summary = _summary(args, report, chosen)
     summary["model"] = simulation.describe()

@@ -10,7 +10,7 @@ import os
 from typing import Any
 
 from ..bodies import Plate, Sphere
-from ..calibration.model_lines import Cost
+from ..calibration.model_lines import Cost, check_finder
 from ..calibration.outcome_model import (
     OUTCOME_BLUNDER,
     RESIDUAL_SIGMA_BOUNDS,
@@ -23,6 +23,7 @@ from ..calibration.pstar import (
     fit_pstar,
     fit_pstar_by_obliquity,
 )
+from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, Estimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..progress import reporting_scenes
@@ -130,16 +131,21 @@ def pstar_command(args: argparse.Namespace) -> None:
         "resolution": SPEED_RESOLUTION if args.resolution is None else args.resolution,
         "tolerance": SPEED_TOLERANCE if args.tolerance is None else args.tolerance,
     }
-    _check_finder(**finder)
+    typed(args).update({"tolerance": "--tolerance", "resolution": "--resolution"})
+    check_finder(**finder)
+    bound = None if args.force else MAX_FIT_SCENES
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
             table = fit_pstar_by_obliquity(
-                shots, plate, sphere=sphere, simulation=simulation, model=model, **finder
-            )
+                shots, plate, sphere=sphere, simulation=simulation, model=model,
+                resolution=finder["resolution"], tolerance=finder["tolerance"],
+                max_scenes=bound,
+            )  # fmt: skip
         else:
             fit = fit_pstar(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
-                fit_alpha=args.alpha_fit, **finder,
+                fit_alpha=args.alpha_fit, resolution=finder["resolution"],
+                tolerance=finder["tolerance"], max_scenes=bound,
             )  # fmt: skip
     if args.by_obliquity:
         summary = _table_summary(args, table, simulation, finder, sphere)
@@ -152,16 +158,6 @@ def pstar_command(args: argparse.Namespace) -> None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
         write_atomically(args.out, plate_file_text(fit.plate, extra), "--out")
     print(json.dumps(summary) if args.json else _fit_text(args, fit))
-
-
-def _check_finder(resolution: float, tolerance: float) -> None:
-    if not (math.isfinite(tolerance) and 0.0 < tolerance <= 10.0):
-        raise UsageError(f"--tolerance: must be in (0, 10] m/s, got {tolerance:g}")
-    if not (math.isfinite(resolution) and tolerance <= resolution <= 100.0):
-        raise UsageError(
-            f"--resolution: must be in [{tolerance:g}, 100] m/s (from the tolerance), "
-            f"got {resolution:g}"
-        )
 
 
 def _finite(x: float) -> float | None:

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
+from ..errors import ArchiveError
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome
@@ -54,6 +55,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
         action="append",
         metavar="OUTCOME",
         help=f"print only the bands of this outcome ({', '.join(OUTCOMES)}); repeatable",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help=f"scan more than {lim.MAX_SCAN_SCENES:,} scenes (memory stays bounded: they run "
+        "10,000 at a time; the time does not)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--csv", metavar="FILE", help="write the bands as CSV")
@@ -108,7 +115,10 @@ def _writable_archive(args: argparse.Namespace) -> Archive | None:
     if args.archive is None:
         return None
     archive = Archive(args.archive)
-    archive.check_writable()
+    try:
+        archive.check_writable()
+    except ArchiveError as exc:  # a name too long, a read-only place, a damaged archive, ...
+        raise UsageError(f"--archive: {exc}") from None
     return archive
 
 
@@ -126,6 +136,15 @@ def _number(text: str, flag: str) -> float:
     if not math.isfinite(value):
         raise UsageError(f"{flag} must be a finite number, got {text!r}")
     return value
+
+
+def _step(text: str, flag: str) -> float:
+    """A tolerance or resolution: any number, NaN and inf included, which the finder's
+    check refuses naming the allowed range (docs/limits.md)."""
+    try:
+        return float(text)
+    except ValueError:
+        raise UsageError(f"{flag} must be a number, got {text!r}") from None
 
 
 def _values(text: str, flag: str, unit: str) -> np.ndarray:
@@ -183,10 +202,10 @@ def limits_command(args: argparse.Namespace) -> None:
     tolerance = lim.SPEED_TOLERANCE if along_speed else lim.OBLIQUITY_TOLERANCE
     resolution = lim.SPEED_RESOLUTION if along_speed else lim.OBLIQUITY_RESOLUTION
     if args.tolerance is not None:
-        tolerance = _number(args.tolerance, "--tolerance") * scale
+        tolerance = _step(args.tolerance, "--tolerance") * scale
         resolution = max(resolution, tolerance)  # a coarse tolerance: a coarse scan
     if args.resolution is not None:
-        resolution = _number(args.resolution, "--resolution") * scale
+        resolution = _step(args.resolution, "--resolution") * scale
     if along_speed:
         lines = _values(args.obliquities, "--obliquities", "deg") * _DEG
         span = lim.SPEED_RANGE if args.speeds is None else _range(args.speeds, "--speeds")
@@ -200,8 +219,9 @@ def limits_command(args: argparse.Namespace) -> None:
         find = lim.along_obliquity
     with reporting_scenes("limits"):  # a count of scenes, per pass, on a terminal after 2 s
         found = find(
-            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution
-        )
+            simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution,
+            max_scenes=None if args.force else lim.MAX_SCAN_SCENES,
+        )  # fmt: skip
     if args.csv is not None:
         write_atomically(args.csv, _csv(found), "--csv")
     if args.png is not None:
@@ -272,7 +292,7 @@ def map_command(args: argparse.Namespace) -> None:
     except ValueError:
         raise UsageError(f"--speeds: N must be an integer >= 2, got {parts[2]!r}") from None
     rows = _values(args.obliquities, "--obliquities", "deg") * _DEG
-    tolerance = _number(args.tolerance, "--tolerance")
+    tolerance = _step(args.tolerance, "--tolerance")
     presets_given = args.preset or [None]
     if args.kind == "outcomes" and len(presets_given) > 4:
         raise UsageError("--preset: an outcome map draws at most 4 plates (one panel each)")

@@ -146,23 +146,22 @@ def run_command(args: argparse.Namespace) -> None:
         fields = list(TRAJECTORY_FIELDS.values())
         rows = zip(*(getattr(path, f.name) / f.scale for f in fields), strict=True)
         write_atomically(args.trajectory, csv_text([f.key for f in fields], rows), "--trajectory")
-    inputs = inputs_record(
-        simulation,
-        scene.sphere,
-        scene.plate,
-        label=label,
-        scene={IMPACT_SPEED: scene.impact_speed, IMPACT_OBLIQUITY: scene.impact_obliquity},
-    )
     speed, obliquity = (_user(d, scene) for d in (IMPACT_SPEED, IMPACT_OBLIQUITY))
-    out: dict[str, Any] = {
-        "preset": label,
-        IMPACT_SPEED.key: speed,
-        IMPACT_OBLIQUITY.key: obliquity,
-    }
-    out.update(result.as_user_dict())
-    out["model"] = simulation.describe()
-    out["inputs"] = inputs
-    if args.json:
+    if args.json:  # the record (source commit, code hashes) only where it is printed
+        out: dict[str, Any] = {
+            "preset": label,
+            IMPACT_SPEED.key: speed,
+            IMPACT_OBLIQUITY.key: obliquity,
+        }
+        out.update(result.as_user_dict())
+        out["model"] = simulation.describe()
+        out["inputs"] = inputs_record(
+            simulation,
+            scene.sphere,
+            scene.plate,
+            label=label,
+            scene={IMPACT_SPEED: scene.impact_speed, IMPACT_OBLIQUITY: scene.impact_obliquity},
+        )
         print(json.dumps(out))
         return
     print(f"{label}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")

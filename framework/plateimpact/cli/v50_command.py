@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -19,6 +19,7 @@ from ..registry import PluginRegistry
 from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP
+from ..v50.likelihood import shown as count_shown
 from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
@@ -223,7 +224,7 @@ def v50_command(args: argparse.Namespace) -> None:
 
 
 def _json(
-    args: argparse.Namespace, obliquity: float, result: Estimate | str, labels: tuple[str, ...],
+    args: argparse.Namespace, obliquity: float, result: Estimate | str, labels: Sequence[str],
     model_limits: dict[float, float | None], model: str | None,
 ) -> dict[str, Any]:  # fmt: skip
     # 30, not 29.999999999999996 after the round trip through rad
@@ -266,9 +267,12 @@ def _text(row: dict[str, Any]) -> str:
         ]
     else:
         resamples = row["bootstrap_resamples"]
+        # shots are rounds (weights counted); the rows too when a row stands for several
+        rows = f" ({row['rows']} rows)" if row["rows"] != row["rounds"] else ""
         lines = [
-            f"{where}: {row['shots']} shots, {row['perforations']} perforated; {row['method']} "
-            f"fit, {100 * row['confidence']:g}% intervals: profile likelihood"
+            f"{where}: {count_shown(row['rounds'])} shots{rows}, "
+            f"{count_shown(row['perforations'])} perforated; {row['method']} fit, "
+            f"{100 * row['confidence']:g}% intervals: profile likelihood"
             + (f" | bootstrap ({resamples} resamples)" if resamples else "")
         ]
         for name, key in (("V50", "v50"), ("sigma", "sigma"), ("V10", "v10"), ("V90", "v90")):
@@ -277,9 +281,11 @@ def _text(row: dict[str, Any]) -> str:
             lines.append(f"  {name:6s}{row[f'{key}_m_s']:9.4g} m/s  {profile}{boot}")
         low, high = row["mixed_zone_m_s"]
         note = f"zone of mixed results {low:g}-{high:g} m/s"
-        if row["bootstrap_separated"] or row["bootstrap_flat"]:
-            note += (f"; of the resamples {row['bootstrap_separated']} separated (sigma 0), "
-                     f"{row['bootstrap_flat']} flat (no rise with speed)")  # fmt: skip
+        kinds = (("bootstrap_separated", "separated (sigma 0)"),
+                 ("bootstrap_flat", "flat (no rise with speed)"),
+                 ("bootstrap_failed", "failed (no fit converged: left out)"))  # fmt: skip
+        if resamples:  # said even when 0: a reader need not guess
+            note += "; of the resamples " + ", ".join(f"{row[k]} {what}" for k, what in kinds)
         lines.append(f"  {note}")
     if "model" in row:
         limit = row["model_ballistic_limit_m_s"]

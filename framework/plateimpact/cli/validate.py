@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..experiment import MEASURED, PREDICTED, ValidationReport, validate
+from ..experiment.validation import MAX_VALIDATE_SCENES
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..storage.shots import Shots
@@ -41,6 +42,12 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
+        "--force",
+        action="store_true",
+        help=f"run more than {MAX_VALIDATE_SCENES:,} scenes (the shots and, should shots on "
+        "every line disagree, the boundary search; refused unasked before any scene runs)",
+    )
+    p.add_argument(
         "--png",
         metavar="FILE",
         help="draw each obliquity's exit speed and obliquity, the model's curves and "
@@ -64,7 +71,8 @@ def validate_command(args: argparse.Namespace) -> None:
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)
     with reporting_scenes("validate"):  # a count of scenes on a terminal after 2 s
-        report = validate(simulation, sphere, plate, shots)
+        bound = None if args.force else MAX_VALIDATE_SCENES
+        report = validate(simulation, sphere, plate, shots, max_scenes=bound)
         if args.png is not None:
             from ..experiment.figure import validation_figure  # noqa: PLC0415 (matplotlib)
 
@@ -81,7 +89,10 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
     shots = report.shots
     model = report.model
     go_no_go = int((shots.outcome == 0).sum())
-    angles = ", ".join(f"{math.degrees(o):.6g}" for o in shots.groups_by_obliquity())
+    obliquities = np.unique(shots.impact_obliquity)  # a file may measure each shot's
+    angles = ", ".join(f"{math.degrees(o):.6g}" for o in obliquities[:LISTED])
+    if obliquities.size > LISTED:
+        angles += f", ... ({obliquities.size:,} obliquities)"
     print(
         f"{label}: {len(shots)} shots from {args.shots}"
         + (f" ({go_no_go} go/no-go)" if go_no_go else "")

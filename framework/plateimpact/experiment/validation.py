@@ -23,7 +23,7 @@ import attrs
 import numpy as np
 
 from ..bodies import MASS, RADIUS, Plate, Sphere
-from ..errors import ShotDataError
+from ..errors import ShotDataError, WorkBoundError
 from ..limits import (
     SPEED_RESOLUTION,
     SPEED_TOLERANCE,
@@ -32,6 +32,8 @@ from ..limits import (
     Regime,
     along_speed,
 )
+from ..limits.chunked import run_chunked
+from ..limits.find import check_steps
 from ..results import Outcome
 from ..scene import IMPACT_SPEED
 from ..simulation import Simulation
@@ -45,6 +47,8 @@ MEASURED = (*(o.label for o in Outcome), PERFORATED, NOT_PERFORATED)
 PREDICTED = tuple(o.label for o in Outcome)
 #: The boundaries are sought this far beyond the slowest and fastest shot (factors).
 SPAN_BELOW, SPAN_ABOVE = 0.5, 1.5
+#: The most scenes validate runs unasked (as a sweep, the limits and the fits).
+MAX_VALIDATE_SCENES = 1_000_000
 _DEG = math.pi / 180.0
 
 
@@ -198,6 +202,37 @@ def boundary_speeds(shots: Shots) -> tuple[float, float]:
     return low, high
 
 
+def work_estimate(
+    shots: Shots, sphere: Sphere, speeds: tuple[float, float], resolution: float
+) -> tuple[int, int, int]:
+    """(scenes at most, lines, samples a line): every shot's scene, and the boundary
+    search's scan along every line (distinct sphere and obliquity) as if a shot on each
+    disagreed; which do is known only once the shots have run."""
+    radius, mass = shots.spheres(sphere)
+    lines = len(np.unique(np.column_stack([radius, mass, shots.impact_obliquity]), axis=0))
+    per_line = math.ceil((speeds[1] - speeds[0]) / resolution) + 1
+    return len(shots) + lines * per_line, lines, per_line
+
+
+def check_work(
+    shots: Shots,
+    sphere: Sphere,
+    speeds: tuple[float, float],
+    resolution: float,
+    max_scenes: int | None,
+) -> None:
+    """:class:`WorkBoundError` if :func:`work_estimate` passes ``max_scenes``."""
+    scenes, lines, per_line = work_estimate(shots, sphere, speeds, resolution)
+    if max_scenes is not None and scenes > max_scenes:
+        raise WorkBoundError(
+            "max_scenes",
+            f"validate: up to {scenes:,} scenes ({len(shots):,} shots, and the boundaries "
+            f"along {lines:,} lines (sphere and obliquity) of {per_line:,} samples should "
+            f"a shot on each disagree), more than {max_scenes:,}: validate fewer shots or "
+            "obliquities at once, or lift the bound (max_scenes=None; --force)",
+        )
+
+
 def _nearest(line: LimitLine, speed: float, measured: Callable[[Regime], bool]) -> float | None:
     """The boundary of ``line`` nearest ``speed`` [m/s] beyond which the model gives what
     was measured (``measured(regime)``: the outcome, or for a go/no-go shot whether it
@@ -244,6 +279,7 @@ def _disagreements(
         limits = along_speed(
             simulation, Sphere(radius=float(r), mass=float(m)), plate, obliquities, speeds,
             tolerance=tolerance, resolution=resolution, executor=executor,
+            max_scenes=None,  # validate bounded the whole search before any scene ran
         )  # fmt: skip
         found.append(limits)
         for i in mine:
@@ -253,7 +289,7 @@ def _disagreements(
     classes = measured_classes(shots)
     disagreements = tuple(
         Disagreement(
-            shots.labels[i],
+            shots.labels[int(i)],
             float(shots.impact_speed[i]),
             float(shots.impact_obliquity[i]),
             classes[i],
@@ -279,18 +315,30 @@ def validate(
     tolerance: float = SPEED_TOLERANCE,
     resolution: float = SPEED_RESOLUTION,
     executor: Executor | None = None,
+    max_scenes: int | None = MAX_VALIDATE_SCENES,
 ) -> ValidationReport:
     """Run the model on every shot and score it (see the module's description).
 
     ``sphere`` is the sphere of shots whose file gives no radius or mass; ``tolerance``
     and ``resolution`` [m/s] are those of the boundary search
-    (:func:`plateimpact.limits.along_speed`). Raises :class:`ShotDataError` when every
-    shot has weight 0 (nothing to score).
+    (:func:`plateimpact.limits.along_speed`). Before any scene runs: :class:`ShotDataError`
+    when every shot has weight 0 (nothing to score), :class:`ParameterError` for a
+    tolerance or resolution out of range, and
+    :class:`~plateimpact.errors.WorkBoundError` when the shots' scenes and the boundary
+    search could together pass ``max_scenes`` (None: no bound; :func:`work_estimate`).
+    The shots run RUN_CHUNK at a time.
     """
     if not shots.weight.sum() > 0.0:
         raise ShotDataError(f"{shots.source}: every shot has weight 0: nothing to score")
-    result = simulation.run_batch(shots.scenes(sphere, plate))
-    predicted = np.asarray(result.outcome, dtype=int)
+    speeds = boundary_speeds(shots)
+    check_steps(tolerance, resolution, speeds, 1, "m/s", 1.0, None)
+    check_work(shots, sphere, speeds, resolution, max_scenes)
+    scenes = shots.scenes(sphere, plate)
+    outputs = {name: np.empty(len(shots)) for name in ("outcome", "exit_speed", "exit_obliquity")}
+    for where, part in run_chunked(simulation, scenes.take, len(shots), executor):
+        for name, values in outputs.items():
+            values[where] = getattr(part, name)
+    predicted = outputs["outcome"].astype(int)
     agrees = np.where(
         shots.outcome != 0,
         shots.outcome == predicted,
@@ -301,10 +349,9 @@ def validate(
     for row, column in zip(classes, predicted, strict=True):
         confusion[row][Outcome(int(column)).label] += 1
     speed_error, angle_error = _exit_errors(
-        shots, predicted, result.exit_speed, result.exit_obliquity
+        shots, predicted, outputs["exit_speed"], outputs["exit_obliquity"]
     )
     speed_rms, speed_bias = _weighted(speed_error, shots.weight)
-    speeds = boundary_speeds(shots)
     disagreements, limits = _disagreements(
         simulation, shots, sphere, plate, predicted, agrees, speeds, tolerance, resolution,
         executor,
@@ -315,8 +362,8 @@ def validate(
         plate=plate,
         model=simulation.describe(),
         predicted_outcome=predicted,
-        predicted_exit_speed=np.asarray(result.exit_speed, dtype=float),
-        predicted_exit_obliquity=np.asarray(result.exit_obliquity, dtype=float),
+        predicted_exit_speed=np.asarray(outputs["exit_speed"], dtype=float),
+        predicted_exit_obliquity=np.asarray(outputs["exit_obliquity"], dtype=float),
         agrees=agrees,
         agreement=float((shots.weight * agrees).sum() / shots.weight.sum()),
         confusion=confusion,

@@ -18,14 +18,16 @@ import numpy as np
 
 from ..batch import SceneBatch
 from ..bodies import MASS, RADIUS, Plate, Sphere
-from ..errors import ParameterError
+from ..errors import ParameterError, WorkBoundError
 from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
+from ..simulation import Simulation
+from ..storage.code_provenance import limits_record, plugins_record
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import source_commit, versions
-from .finder import SECTIONS, locate
+from .chunked import run_chunked
+from .finder import GROUP_SCENES, RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
 from .regimes import Regime, regime_codes
 
@@ -48,7 +50,9 @@ class Limits:
     ``resolution`` are in its SI unit (m/s or rad); ``model`` is the simulation's
     plug-ins and settings; ``scenes`` how many scenes the finder ran, ``passes`` its
     refinement passes, ``seconds`` the wall time (for plates found together, the
-    request's: see :func:`~plateimpact.limits.outcome_maps`).
+    request's: see :func:`~plateimpact.limits.outcome_maps`); ``plugins`` the code
+    that found them (storage.code_provenance; None if read from a record made before
+    it was recorded).
     """
 
     axis: str
@@ -61,6 +65,7 @@ class Limits:
     scenes: int
     passes: int
     seconds: float
+    plugins: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
         """One object in user units (``plateimpact limits --json``)."""
@@ -80,6 +85,7 @@ class Limits:
             "scenes": self.scenes,
             "versions": versions(),
             "source_commit": source_commit(),
+            "plugins": self.plugins,
         }
 
 
@@ -108,29 +114,51 @@ def _interval(name: str, values: tuple[float, float], declared: Any) -> tuple[fl
     return start, stop
 
 
-def _steps(
-    tolerance: float, resolution: float, span: float, lines: int, unit: str, scale: float
+def check_steps(
+    tolerance: float,
+    resolution: float,
+    span: tuple[float, float],
+    lines: int,
+    unit: str,
+    scale: float,
+    max_scenes: int | None = MAX_SCAN_SCENES,
 ) -> None:
-    """Tolerance in (0, span]; resolution in [tolerance, span]; a scan of at most
-    MAX_SCAN_SCENES scenes."""
-    shown = f"{span / scale:.6g} {unit}"
-    if not (math.isfinite(tolerance) and 0.0 < tolerance <= span):
+    """Tolerance in [RELATIVE_FLOOR of the range's largest value, the range's width];
+    resolution in [tolerance, the width]; a scan of at most GROUP_SCENES samples a line
+    and ``max_scenes`` (None: any number) in all. The floor is what a double resolves
+    there: finer cuts would coincide (limits.finder)."""
+    width = span[1] - span[0]
+    shown = f"{width / scale:.6g} {unit}"
+    floor = finest_tolerance(np.array([span[0]]), np.array([span[1]]))
+    if not (math.isfinite(tolerance) and floor <= tolerance <= width):
         raise ParameterError(
-            "tolerance", f"tolerance must be in (0, {shown}] (the range), got {tolerance / scale:g}"
+            "tolerance",
+            f"tolerance must be in [{floor / scale:.3g}, {width / scale:.6g}] {unit} (from "
+            f"{RELATIVE_FLOOR:g} of "
+            f"the range's largest value, about what a double resolves there, to the range), "
+            f"got {tolerance / scale:g}",
         )
-    if not (math.isfinite(resolution) and tolerance <= resolution <= span):
+    if not (math.isfinite(resolution) and tolerance <= resolution <= width):
         raise ParameterError(
             "resolution",
-            f"resolution must be in [{tolerance / scale:g}, {shown}] (from the tolerance to "
-            f"the range), got {resolution / scale:g}",
+            f"resolution must be in [{tolerance / scale:g}, {width / scale:.6g}] {unit} (from "
+            f"the tolerance to the range), got {resolution / scale:g}",
         )
-    scan = lines * (math.ceil(span / resolution) + 1)
-    if scan > MAX_SCAN_SCENES:
+    per_line = math.ceil(width / resolution) + 1
+    if per_line > GROUP_SCENES:
         raise ParameterError(
             "resolution",
-            f"resolution {resolution / scale:g} {unit} over {lines} line(s) of {shown} needs "
-            f"{scan:,} scenes, more than {MAX_SCAN_SCENES:,}: coarsen it, or ask for fewer "
-            "lines or a shorter range",
+            f"resolution {resolution / scale:g} {unit} over {shown} makes {per_line:,} "
+            f"samples a line, more than {GROUP_SCENES:,} (no override: coarsen it or "
+            "shorten the range)",
+        )
+    scan = lines * per_line
+    if max_scenes is not None and scan > max_scenes:
+        raise WorkBoundError(
+            "resolution",
+            f"resolution {resolution / scale:g} {unit} over {lines:,} line(s) of {shown} "
+            f"needs {scan:,} scenes, more than {max_scenes:,}: coarsen it, ask for fewer "
+            "lines or a shorter range, or lift the bound (max_scenes=None; --force)",
         )
 
 
@@ -158,14 +186,23 @@ def _find(
     fixed_of_line = np.tile(fixed, len(plates))
 
     def evaluate(line: np.ndarray, x: np.ndarray) -> np.ndarray:
-        speed, obliquity = (x, fixed_of_line[line]) if axis == SPEED else (fixed_of_line[line], x)
-        batch = base.take(plate_of_line[line]).with_columns(
-            impact_speed=speed, impact_obliquity=obliquity
-        )
-        result = simulation.run_batch(batch, executor=executor, chunk_size=DEFAULT_CHUNK_SIZE)
-        if scans is not None and not scans:
-            scans.append(result)
-        return regime_codes(result)
+        def batch_of(index: np.ndarray) -> SceneBatch:
+            on, at = line[index], x[index]
+            speed, obliquity = (at, fixed_of_line[on]) if axis == SPEED else (fixed_of_line[on], at)
+            return base.take(plate_of_line[on]).with_columns(
+                impact_speed=speed, impact_obliquity=obliquity
+            )
+
+        codes = np.empty(x.size, dtype=np.int64)
+        keep = scans is not None and not scans  # the scan's results, for a map
+        kept = []
+        for where, result in run_chunked(simulation, batch_of, x.size, executor):
+            codes[where] = regime_codes(result)
+            if keep:
+                kept.append(result)
+        if scans is not None and keep:
+            scans.append(BatchResult.concat(kept))
+        return codes
 
     began = time.perf_counter()
     starts, ends = np.full(fixed_of_line.size, span[0]), np.full(fixed_of_line.size, span[1])
@@ -184,6 +221,7 @@ def _find(
         first = Regime.of_code(int(found.first[i]))
         lines.append(LimitLine(axis, float(value), span[0], span[1], boundaries, first))
     model = simulation.describe()
+    plugins = {**plugins_record(simulation), "limits": limits_record()}
     n = fixed.size
     return [
         Limits(
@@ -197,6 +235,7 @@ def _find(
             found.scenes,
             found.passes,
             seconds,
+            plugins,
         )  # fmt: skip
         for k, plate in enumerate(plates)
     ]
@@ -212,17 +251,20 @@ def along_speed(
     tolerance: float = SPEED_TOLERANCE,
     resolution: float = SPEED_RESOLUTION,
     executor: Executor | None = None,
+    max_scenes: int | None = MAX_SCAN_SCENES,
 ) -> Limits:
     """The outcome bands along impact speed at each of ``obliquities`` [rad].
 
     ``speeds`` is the range (start, stop) [m/s]. Every boundary is bracketed to within
     ``tolerance`` [m/s], and no band ``resolution`` [m/s] wide or wider is missed
     (docs/limits.md). ``executor`` (a process pool) spreads the scan over workers.
+    A scan of more than ``max_scenes`` scenes (None: no bound) is refused before any
+    scene runs (:class:`~plateimpact.errors.WorkBoundError`).
     """
     fixed = _floats("obliquities", obliquities)
     IMPACT_OBLIQUITY.check(fixed)
     span = _interval("speeds", speeds, IMPACT_SPEED)
-    _steps(tolerance, resolution, span[1] - span[0], fixed.size, "m/s", 1.0)
+    check_steps(tolerance, resolution, span, fixed.size, "m/s", 1.0, max_scenes)
     (found,) = _find(
         simulation, sphere, [plate], SPEED, fixed, span, tolerance, resolution, executor
     )
@@ -239,16 +281,17 @@ def along_obliquity(
     tolerance: float = OBLIQUITY_TOLERANCE,
     resolution: float = OBLIQUITY_RESOLUTION,
     executor: Executor | None = None,
+    max_scenes: int | None = MAX_SCAN_SCENES,
 ) -> Limits:
     """The outcome bands along impact obliquity at each of ``speeds`` [m/s].
 
     ``obliquities`` is the range (start, stop) [rad], within [0, π/2); ``tolerance`` and
-    ``resolution`` [rad] as for :func:`along_speed`.
+    ``resolution`` [rad] and ``max_scenes`` as for :func:`along_speed`.
     """
     fixed = _floats("speeds", speeds)
     IMPACT_SPEED.check(fixed)
     span = _interval("obliquities", obliquities, IMPACT_OBLIQUITY)
-    _steps(tolerance, resolution, span[1] - span[0], fixed.size, "deg", _DEG)
+    check_steps(tolerance, resolution, span, fixed.size, "deg", _DEG, max_scenes)
     (found,) = _find(
         simulation, sphere, [plate], OBLIQUITY, fixed, span, tolerance, resolution, executor
     )

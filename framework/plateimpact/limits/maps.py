@@ -22,8 +22,8 @@ from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
-from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, _steps
-from .finder import scan_points
+from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, check_steps
+from .finder import RELATIVE_FLOOR, finest_tolerance, scan_points
 from .lines import SPEED
 from .regimes import Regime, regime_codes
 
@@ -145,12 +145,14 @@ def outcome_maps(
             f"give at least one plate and at most {MAX_MAP_SCENES:,} scenes",
         )
     resolution = (span[1] - span[0]) / (speed_samples - 1)
-    _steps(min(tolerance, resolution), resolution, span[1] - span[0], rows.size, "m/s", 1.0)
-    if not (math.isfinite(tolerance) and 0.0 < tolerance <= resolution):
+    floor = finest_tolerance(np.array([span[0]]), np.array([span[1]]))
+    if not (math.isfinite(tolerance) and floor <= tolerance <= resolution):
         raise ParameterError(
             "tolerance",
-            f"tolerance must be in (0, {resolution:g}] m/s (the map's spacing), got {tolerance:g}",
+            f"tolerance must be in [{floor:.3g}, {resolution:g}] m/s (from {RELATIVE_FLOOR:g} "
+            f"of the fastest speed to the map's spacing), got {tolerance:g}",
         )
+    check_steps(tolerance, resolution, span, rows.size, "m/s", 1.0)
     scans: list[BatchResult] = []
     found = _find(
         simulation, sphere, plates, SPEED, rows, span, tolerance, resolution, executor, scans

@@ -18,19 +18,26 @@ from typing import Any
 import numpy as np
 
 from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..errors import ArchiveError, ParameterError
+from ..errors import ArchiveError, ParameterError, PlateImpactError
 from ..parameters import Parameter
 from ..registry import default_registry
+from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import git_commit, versions
 from ..storage.records import Column, Record
+from ..storage.untrusted import printable
 from .find import Limits
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
 from .regimes import REGIMES, Regime
 
 KIND_LIMITS, KIND_MAP = "limits", "outcome_map"
+#: A record's attributes by type: JSON objects, texts and numbers (docs/archive.md).
+JSON_ATTRIBUTES = ("plate", "model", "versions", "regimes")
+TEXT_ATTRIBUTES = ("kind", "axis", "axis_units", "tolerance_units", "resolution_units",
+                   "git_commit", "host", "creation_time", "description")  # fmt: skip
+NUMBER_ATTRIBUTES = ("tolerance", "resolution", "scenes", "passes", "wall_time_s")
 #: Each axis's SI unit and name.
 UNITS = {SPEED: "m/s", OBLIQUITY: "rad"}
 NAMES = {SPEED: "impact speed", OBLIQUITY: "impact obliquity"}
@@ -136,6 +143,8 @@ def to_record(found: Limits | OutcomeMap) -> Record:
         "wall_time_s": float(limits.seconds),
         "regimes": json.dumps({str(r.code): r.label for r in REGIMES}),
     }
+    if limits.plugins is not None:  # the code that found them (docs/archive.md, Provenance)
+        attributes["plugins"] = json.dumps(limits.plugins, sort_keys=True)
     columns = _body_columns(limits.sphere, limits.plate) | _axis_columns(limits)
     if isinstance(found, OutcomeMap):
         columns |= {
@@ -152,6 +161,14 @@ def to_record(found: Limits | OutcomeMap) -> Record:
     return Record(attributes, columns)
 
 
+def _plugins(attributes: dict[str, object], what: str) -> dict[str, Any] | None:
+    """The recorded ``plugins`` (None in records made before they were recorded)."""
+    if "plugins" not in attributes:
+        return None
+    found: dict[str, Any] = typed.json_value(attributes, "plugins", what, dict)
+    return found
+
+
 def _number(attributes: dict[str, object], key: str) -> float:
     value = attributes[key]
     if isinstance(value, bool) or not isinstance(value, int | float):
@@ -159,15 +176,16 @@ def _number(attributes: dict[str, object], key: str) -> float:
     return float(value)
 
 
-def from_record(record: Record) -> Limits | OutcomeMap:
+def from_record(record: Record, what: str = "stored limits") -> Limits | OutcomeMap:
     """The limits or map a record holds (ValueError, KeyError or TypeError if it is
-    not one)."""
+    not one; ArchiveError naming ``what`` for an attribute of the wrong type: they come
+    from a file, maybe someone else's)."""
     attributes, columns = record.attributes, record.columns
 
     def data(where: str) -> np.ndarray:
         return columns[where].data
 
-    kind, axis = attributes["kind"], str(attributes["axis"])
+    kind, axis = typed.text(attributes, "kind", what), typed.text(attributes, "axis", what)
     if kind not in (KIND_LIMITS, KIND_MAP) or axis not in UNITS:
         raise ValueError(f"kind {kind!r} along {axis!r} is not one this plateimpact reads")
     sphere = Sphere(float(data("sphere/radius")[0]), float(data("sphere/mass")[0]))
@@ -176,7 +194,9 @@ def from_record(record: Record) -> Limits | OutcomeMap:
         for where, column in columns.items()
         if where.startswith("plate/") and where != "plate/thickness"
     }
-    material = json.loads(str(attributes["plate"]))["material"]
+    material = typed.json_value(attributes, "plate", what, dict).get("material")
+    if not isinstance(material, str):
+        raise ArchiveError(f"{what}: attribute plate names no material")
     plate = Plate(material, float(data("plate/thickness")[0]), constants)
     index, low, high = data("boundaries/line"), data("boundaries/low"), data("boundaries/high")
     below, above = data("boundaries/below"), data("boundaries/above")
@@ -200,10 +220,11 @@ def from_record(record: Record) -> Limits | OutcomeMap:
         _number(attributes, "resolution"),
         sphere,
         plate,
-        json.loads(str(attributes["model"])),
+        typed.json_value(attributes, "model", what, dict),
         int(_number(attributes, "scenes")),
         int(_number(attributes, "passes")),
         _number(attributes, "wall_time_s"),
+        _plugins(attributes, what),
     )
     if kind == KIND_LIMITS:
         return limits
@@ -249,12 +270,15 @@ def read_limits(archive: Archive | str | os.PathLike[str], name: str) -> Limits 
     no such name (the message lists those there are)."""
     where = _archive(archive)
     record = where.record(name)
+    what = f"archive {where.path}: limits {printable(name)}"
     try:
-        return from_record(record)
-    except (KeyError, ValueError, TypeError, IndexError) as exc:
+        return from_record(record, what)
+    except ArchiveError:
+        raise
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError, PlateImpactError) as exc:
+        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
         raise ArchiveError(
-            f"archive {where.path}: limits {name!r} cannot be read back ({type(exc).__name__}: "
-            f"{str(exc).splitlines()[0] if str(exc) else 'missing'}); the record is damaged"
+            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
         ) from None
 
 
@@ -264,9 +288,18 @@ def stored_limits(archive: Archive | str | os.PathLike[str]) -> list[str]:
 
 
 def attributes_of(archive: Archive | str | os.PathLike[str], name: str) -> dict[str, Any]:
-    """The stored attributes of ``name`` (checked), JSON ones decoded: for listings."""
-    out: dict[str, Any] = {}
-    for key, value in _archive(archive).record(name).attributes.items():
-        decode = key in ("plate", "model", "versions", "regimes")
-        out[key] = json.loads(str(value)) if decode else value
+    """The stored attributes of ``name`` (checked), JSON ones decoded and every one the
+    listings use typed (ArchiveError, one line, if one is not what the format says)."""
+    where = _archive(archive)
+    attributes = where.record(name).attributes
+    what = f"archive {where.path}: limits {printable(name)}"
+    out: dict[str, Any] = dict(attributes)
+    for key in JSON_ATTRIBUTES:
+        out[key] = typed.json_value(attributes, key, what, dict)
+    if "plugins" in attributes:  # optional: records made before it was recorded lack it
+        out["plugins"] = typed.json_value(attributes, "plugins", what, dict)
+    for key in TEXT_ATTRIBUTES:
+        out[key] = typed.text(attributes, key, what)
+    for key in NUMBER_ATTRIBUTES:
+        out[key] = typed.number(attributes, key, what)
     return out

@@ -12,14 +12,11 @@ died before the rename) is removed by the next writer.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
-import os
-import re
-import secrets
-import shutil
-import tempfile
-from collections.abc import Callable, Sequence
-from pathlib import Path, PurePath
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
 from typing import Protocol
 
 import h5py
@@ -31,9 +28,18 @@ from ..parameters import Parameter
 from ..registry import default_registry
 from ..results import BatchResult
 from ..variant import Variant
+from .confined import directory, fsync_fd, shown_version, write_file
+from .contained import check_contained, data_file, index_link_allowed
+from .data_files import (  # noqa: F401 (data_directory and encoded: their public home)
+    DataFiles,
+    data_directory,
+    encoded,
+    read_index,
+    remove_orphans,
+)
 from .hdf5 import seal
 from .netcdf import write_run_file, write_scenes_file
-from .output import fsync_directory, keep_mode
+from .untrusted import printable
 
 FORMAT, FORMAT_VERSION = "plateimpact-archive", 2
 #: Versions this plateimpact reads; it appends to FORMAT_VERSION only.
@@ -66,106 +72,25 @@ def fault_point(stage: str) -> None:
     unless a test replaces it to fail or crash there deterministically."""
 
 
-def data_directory(real: Path) -> Path:
-    """Where the data files of the archive (index) ``real`` live: ``ARCHIVE.d``."""
-    return real.with_name(f"{real.name}.d")
-
-
-def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9._+-]+", "_", text)[:60] or "_"
-
-
-class DataFiles:
-    """The data files one append writes: each complete and fsync'ed before the index
-    names it; removed again if the append fails; files it retires (a run replaced by
-    ``overwrite``) removed only once the new index is in place."""
-
-    def __init__(self, real: Path) -> None:
-        self.real = real
-        self.directory = data_directory(real)
-        self.written: list[Path] = []
-        self.retired: list[Path] = []
-
-    def new(self, stem: str, write: Callable[[Path], None]) -> str:
-        """Write a data file through ``write(path)``; returns its name relative to the
-        index's directory (the external link's target)."""
-        if not self.directory.is_dir():
-            self.directory.mkdir()
-            if self.real.exists():  # whoever may read the index may read its data
-                readers = os.stat(self.real).st_mode & 0o044
-                os.chmod(self.directory, 0o700 | readers | readers >> 2)
-        name = f"{_slug(stem)}.{secrets.token_hex(4)}.nc"
-        fd, temporary = tempfile.mkstemp(dir=self.directory, prefix=f".{name}.", suffix=".tmp")
-        os.close(fd)
-        try:
-            write(Path(temporary))
-            with open(temporary, "rb+") as handle:
-                os.fsync(handle.fileno())
-            keep_mode(temporary, self.real)
-            os.replace(temporary, self.directory / name)
-        finally:
-            Path(temporary).unlink(missing_ok=True)
-        self.written.append(self.directory / name)
-        return f"{self.directory.name}/{name}"
-
-    def retire(self, target: str) -> None:
-        self.retired.append(self.directory / PurePath(target).name)
-
-    def rollback(self) -> None:
-        for path in self.written:
-            path.unlink(missing_ok=True)
-
-    def commit(self) -> None:
-        for path in self.retired:
-            path.unlink(missing_ok=True)
-
-
-def linked_files(f: h5py.File) -> set[str]:
-    """The data files the index ``f`` names (its external links' targets)."""
-    found: set[str] = set()
-
-    def visit(name: str, link: object) -> None:
-        if isinstance(link, h5py.ExternalLink):
-            found.add(link.filename)
-
-    f.visititems_links(visit)
-    return found
-
-
-def _link_count(f: h5py.File) -> int:
-    """How many data files the index ``f`` names: each study's scenes and runs, each
-    record (counted per group, without walking the links)."""
-    count = 0
-    for name in f:
-        group = f[name]
-        if "scenes" in group:
-            count += 1 + len(group.get("runs", ()))
-        else:
-            count += len(group)
-    return count
-
-
-def remove_orphans(real: Path) -> None:
-    """Remove what killed writers left: temporaries beside the index and in its data
-    directory, and data files no index names. The caller holds the lock."""
-    for stale in real.parent.glob(f".{real.name}.*.tmp"):
-        stale.unlink(missing_ok=True)  # we hold the lock: no live writer uses one
-    directory = data_directory(real)
-    if not directory.is_dir():
-        return
-    present = list(directory.iterdir())
-    named = set()
-    if real.exists():
-        with h5py.File(real, "r") as f:
-            data = [p for p in present if p.suffix == ".nc"]
-            if len(data) == _link_count(f) and not any(p.name.endswith(".tmp") for p in present):
-                return  # one file per link: nothing left behind (the usual case, cheaply)
-            named = {PurePath(target).name for target in linked_files(f)}  # by file name:
-            # the index may have been renamed
-    for path in present:
-        orphan = path.name.endswith(".tmp") or (path.suffix == ".nc" and path.name not in named)
-        if orphan and path.is_file():
-            path.unlink(missing_ok=True)
+@contextlib.contextmanager
+def open_index(image: io.BytesIO, exists: bool, real: Path) -> Iterator[tuple[h5py.File, set[str]]]:
+    """The index held in ``image`` (new if not ``exists``), open for writing in memory,
+    with the data files it names; damage, another format version or anything that
+    reaches outside the archive is an ArchiveError."""
+    try:
+        f = h5py.File(image, "r+" if exists else "w")
+    except Exception as exc:  # noqa: BLE001 (h5py raises many kinds from a damaged file)
+        raise ArchiveError(f"archive {real} cannot be opened: {_first_line(exc)}") from None
+    with f:
+        if exists:
+            version = f.attrs.get("format_version")
+            if f.attrs.get("format") != FORMAT or version != FORMAT_VERSION:
+                raise ArchiveError(
+                    f"archive {real} has format version {shown_version(version)}; this "
+                    f"plateimpact appends to version {FORMAT_VERSION} only (plateimpact upgrade)"
+                )
+        named = check_contained(f, f"archive {real}", index_link_allowed) if exists else set()
+        yield f, named
 
 
 def append(
@@ -181,84 +106,101 @@ def append(
     """Add one run to the archive ``real`` (or create it) as ``run`` (default: the
     variant's name): its data file, then the index. A run of that name is replaced with
     ``overwrite``, else refused (:class:`RunExistsError`). Returns the run's name."""
+    return append_with(real, lambda f, files: add_run(
+        f, files, study, variant, result, attributes, constants, run, overwrite
+    ))  # fmt: skip
+
+
+def add_run(
+    f: h5py.File,
+    files: DataFiles,
+    study: StudyDefinition,
+    variant: Variant,
+    result: BatchResult,
+    attributes: dict[str, object],
+    constants: dict[str, Parameter],
+    run: str | None = None,
+    overwrite: bool = False,
+) -> str:
+    """Write the run's data file and link it from the open index ``f``."""
     name = run or variant.name
-
-    def add_run(f: h5py.File, files: DataFiles) -> str:
-        group = study_group(f, files, study, constants, real)
-        runs = group["runs"]
-        if name in runs:
-            if not overwrite:
-                raise RunExistsError(
-                    f"archive {real} already has run {study.name}/{name}: keep it (resume), "
-                    "replace it (overwrite) or name the new run otherwise"
-                )
-            old = runs.get(name, getlink=True)
-            if isinstance(old, h5py.ExternalLink):
-                files.retire(old.filename)
-            del runs[name]
-        declared = {k: _scene_column(k, constants) for k in study.scenes.columns}
-        target = files.new(
-            f"{study.name}.{name}",
-            lambda path: write_run_file(
-                path, study.scenes.columns, declared, study.plate_labels, result,
-                {"study": study.name, "run": name, **attributes},
-            ),
-        )  # fmt: skip
-        runs[name] = h5py.ExternalLink(target, "/")
-        return name
-
-    return append_with(real, add_run)
+    real = files.real
+    group = study_group(f, files, study, constants, real)
+    runs = _group(group, "runs", f"archive {real}: study {printable(study.name)}")
+    if name in runs:
+        if not overwrite:
+            raise RunExistsError(
+                f"archive {real} already has run {study.name}/{name}: keep it (resume), "
+                "replace it (overwrite) or name the new run otherwise"
+            )
+        old = runs.get(name, getlink=True)
+        if isinstance(old, h5py.ExternalLink):
+            files.retire(old.filename)
+        del runs[name]
+    declared = {k: _scene_column(k, constants) for k in study.scenes.columns}
+    target = files.new(
+        f"{study.name}.{name}",
+        lambda handle: write_run_file(
+            handle, study.scenes.columns, declared, study.plate_labels, result,
+            {"study": study.name, "run": name, **attributes},
+        ),
+    )  # fmt: skip
+    runs[name] = h5py.ExternalLink(target, "/")
+    return name
 
 
 def append_with(real: Path, write: Callable[[h5py.File, DataFiles], str]) -> str:
     """Extend the archive ``real`` (or create it) with ``write(index, files)``, which
-    writes its data files through ``files`` and links them from the open copy of the
-    index, returning the name it stored them under: the index is copied, extended,
-    fsync'ed and renamed over the original, each stage a fault point; on any failure
-    the new data files are removed again. The caller holds the archive's lock."""
-    remove_orphans(real)
-    files = DataFiles(real)
-    fd, name = tempfile.mkstemp(
-        dir=real.parent, prefix=f".{real.name}.{os.getpid()}.", suffix=".tmp"
-    )
-    os.close(fd)
-    temporary = Path(name)
-    try:
-        fault_point("copy")
-        if real.exists():
-            shutil.copyfile(real, temporary)
-        fault_point("write")
-        with h5py.File(temporary, "a") as f:
-            if f.attrs.get("format_version", FORMAT_VERSION) != FORMAT_VERSION:
-                raise ArchiveError(
-                    f"archive {real} has format version {f.attrs['format_version']}; this "
-                    f"plateimpact appends to version {FORMAT_VERSION} only (plateimpact upgrade)"
-                )
-            if "format" not in f.attrs:
-                f.attrs["format"] = FORMAT
-                f.attrs["format_version"] = FORMAT_VERSION
-                f.attrs["description"] = (
-                    f"plateimpact study archive (index; the runs' data in {files.directory.name}/"
-                    "); see docs/archive.md"
-                )
-            stored = write(f, files)
+    writes its data files through ``files`` and links them from the index, returning
+    the name it stored them under. The index is read, extended in memory and written
+    whole to a temporary beside it, fsync'ed and renamed over the original, each stage
+    a fault point ("copy", "write", "flush", "fsync", "replace"); on any failure the
+    new data files are removed again and the index is as it was. The caller holds the
+    archive's lock."""
+    with directory(real.parent, f"archive {real}: directory", follow=True) as parent:
+        files = DataFiles(real, parent)
+        try:
+            fault_point("copy")
+            old = read_index(parent, real)
+            image = io.BytesIO(old or b"")
+            with open_index(image, old is not None, real) as (f, named):
+                remove_orphans(files, named)
+                if old is None:
+                    f.attrs["format"] = FORMAT
+                    f.attrs["format_version"] = FORMAT_VERSION
+                    f.attrs["description"] = (
+                        f"plateimpact study archive (index; the runs' data in "
+                        f"{files.directory.name}/); see docs/archive.md"
+                    )
+                fault_point("write")
+                stored = write(f, files)
+                if files.retired:  # the files the new index still names are kept
+                    files.kept = check_contained(f, f"archive {real}", index_link_allowed)
             fault_point("flush")
-        with open(temporary, "rb+") as handle:
-            fault_point("fsync")
-            os.fsync(handle.fileno())
-        if files.written:
-            fsync_directory(files.directory)
-        keep_mode(str(temporary), real)
-        fault_point("replace")
-        os.replace(temporary, real)
-        fsync_directory(real.parent)
-    except BaseException:
-        files.rollback()
-        raise
-    finally:
-        temporary.unlink(missing_ok=True)
-    files.commit()
+            files.sync()
+            write_file(parent, real.name, image.getbuffer(), real, lambda stage: fault_point(stage))
+            fsync_fd(parent)
+            files.commit()
+        except BaseException:
+            files.rollback()
+            raise
+        finally:
+            files.close()
     return stored
+
+
+def _group(parent: h5py.Group, name: str, what: str) -> h5py.Group:
+    """The group ``name`` of ``parent``, which an index from someone else may hold as
+    anything else."""
+    found = parent.get(name)
+    if not isinstance(found, h5py.Group):
+        raise ArchiveError(f"{what}: {printable(name)} is not a group; the archive is damaged")
+    return found
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return printable(text[0], 200) if text else type(exc).__name__
 
 
 def check_same_scenes(scenes: h5py.Group, study: StudyDefinition, path: Path) -> None:
@@ -266,13 +208,19 @@ def check_same_scenes(scenes: h5py.Group, study: StudyDefinition, path: Path) ->
     stored study's scenes group or file)."""
     names = set(study.scenes.columns)
     stored = set(scenes) - {"plate_label", "plate", "scene"}  # labels; netCDF's dimension
-    same = stored == names and all(
-        np.array_equal(scenes[k][()], study.scenes.columns[k]) for k in names
-    )
+    same = stored == names and all(_same(scenes.get(k), study.scenes.columns[k]) for k in names)
     if not same:
         raise ArchiveError(
             f"archive {path} already holds a different study named {study.name!r}; rename the study"
         )
+
+
+def _same(stored: object, values: np.ndarray) -> bool:
+    """Whether the stored dataset holds ``values`` (its shape compared first: a shape from
+    someone else is not read whole before it is known to be the study's)."""
+    if not isinstance(stored, h5py.Dataset) or stored.shape != values.shape:
+        return False
+    return bool(np.array_equal(stored[()], values))
 
 
 def study_group(
@@ -284,9 +232,13 @@ def study_group(
 ) -> h5py.Group:
     """The study's group in the index, made (with its scenes' data file) if new."""
     if study.name in f:
-        group = f[study.name]
+        what = f"archive {path}: study {printable(study.name)}"
+        group = _group(f, study.name, f"archive {path}")
         link = group.get("scenes", getlink=True)
-        with h5py.File(path.parent / link.filename, "r") as scenes:
+        if not isinstance(link, h5py.ExternalLink):
+            raise ArchiveError(f"{what} has no link to its scenes; the archive is damaged")
+        # by its name in the archive's own data directory now (a renamed archive too)
+        with data_file(files.directory, link.filename, f"{what}: scenes") as scenes:
             check_same_scenes(scenes, study, path)
         return group
     group = f.create_group(study.name)
@@ -298,8 +250,8 @@ def study_group(
     declared = {k: _scene_column(k, constants) for k in study.scenes.columns}
     target = files.new(
         f"{study.name}.scenes",
-        lambda where: write_scenes_file(
-            where, study.scenes.columns, declared, study.plate_labels,
+        lambda handle: write_scenes_file(
+            handle, study.scenes.columns, declared, study.plate_labels,
             {"study": study.name, "description": study.description},
         ),
     )  # fmt: skip

@@ -15,32 +15,33 @@ Format-1 archives (one file holding everything) are read; appends go to format 2
 
 from __future__ import annotations
 
-import datetime as dt
-import json
 import os
-import stat
 from collections.abc import Callable
-from pathlib import Path, PurePath
+from pathlib import Path
 
 import attrs
 import h5py
+import numpy as np
 
 from ..batch import SceneBatch
-from ..errors import ArchiveError, ParameterError, UnknownNameError
+from ..errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
 from ..parameters import Parameter
-from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
+from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
 from ..variant import Variant
 from . import append as append_module
 from . import records
+from . import stored_attributes as typed
 from .append import (
-    FORMAT_VERSION,
     StudyDefinition,
     append,
     check_same_scenes,
 )
+from .confined import data_file_name
 from .lock import ArchiveBusyError, locked
 from .reader import ArchiveFiles
 from .records import LIMITS, Record
+from .untrusted import printable
+from .writable import check_writable, side_archive
 
 #: How long a writer waits for another one to finish with the archive [s].
 WAIT = 300.0
@@ -81,38 +82,13 @@ class Archive(ArchiveFiles):
 
     def check_writable(self, study: str | None = None) -> None:
         """Refuse early what :meth:`append_run` would refuse after a long run: a missing
-        or unwritable directory, a target that is not a regular file, a read-only
-        archive, one that is damaged or of another format version, a ``study`` named as
-        the stored limits' group."""
-        directory = self.real.parent
-        if not self.named or self.real.is_dir():
-            raise ArchiveError(f"archive {self.path!s}: give an archive file name")
-        if not directory.is_dir():
-            raise ArchiveError(f"archive {self.path}: directory {directory} does not exist")
-        if not os.access(directory, os.W_OK | os.X_OK):
-            raise ArchiveError(f"archive {self.path}: directory {directory} is not writable")
-        if self.data.exists() and not (
-            self.data.is_dir() and os.access(self.data, os.W_OK | os.X_OK)
-        ):
-            raise ArchiveError(
-                f"archive {self.path}: its data directory {self.data} is not a writable directory"
-            )
-        if study is not None:
-            records.check_study_name(study, self.path)
-        if self.real.exists():
-            mode = os.stat(self.real).st_mode
-            if not stat.S_ISREG(mode):
-                raise ArchiveError(f"archive {self.path} is not a regular file")
-            if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
-                raise ArchiveError(f"archive {self.path} is read-only; refusing to append to it")
-            with self._open() as f:  # damaged, not an archive, another version: refused now
-                version = f.attrs.get("format_version")
-            if version != FORMAT_VERSION:
-                raise ArchiveError(
-                    f"archive {self.path} has format version {version}, which this plateimpact "
-                    f"reads but does not append to; `plateimpact upgrade {self.path}` "
-                    f"rewrites it as version {FORMAT_VERSION}"
-                )
+        or unwritable directory (a read-only filesystem), names too long for the files
+        the archive makes, a target that is not a regular file, a read-only archive, a
+        data directory or lock that is a symlink or not what it should be, an archive
+        that is damaged, of another format version or reaches outside itself (its
+        links are checked, and a study's scenes opened), a ``study`` named as the
+        stored limits' group."""
+        check_writable(self, study)
 
     def append_run(
         self,
@@ -171,11 +147,9 @@ class Archive(ArchiveFiles):
                 stored = add(self.real)
                 append_module.fault_point("unlock")
         except ArchiveBusyError as exc:
-            side = self.real.with_name(
-                f"{self.real.stem}.{side_tag}.{dt.datetime.now(dt.UTC):%Y%m%dT%H%M%S%f}"
-                f"{self.real.suffix}"
-            )
-            add(side)
+            side = side_archive(self.real, side_tag)
+            with locked(side, side, side.with_name(f"{side.name}.lock"), 0.0):
+                add(side)
             raise ArchiveBusyError(f"{exc}; {label(name)} saved to {side}") from None
         except ArchiveError:
             raise
@@ -207,7 +181,7 @@ class Archive(ArchiveFiles):
         for run in self.runs():
             if run.split("/", 1)[0] != study.name:
                 continue
-            recorded = Variant.from_json(str(self._attributes(run)["variant"]))
+            recorded = self.recorded_variant(run)
             if recorded in study.variants and recorded.name not in found:
                 found[recorded.name] = run
         return found
@@ -249,7 +223,9 @@ class Archive(ArchiveFiles):
         if len(matches) == 1:
             return matches[0]
         hint = "ambiguous; " if matches else ""
-        raise UnknownNameError(f"no run {run!r} in {self.path} ({hint}runs: {', '.join(runs)})")
+        raise UnknownNameError(
+            f"no run {printable(run)!r} in {self.path} ({hint}runs: {_listed(runs)})"
+        )
 
     def data_file(self, run: str) -> Path | None:
         """The run's own netCDF file (format 2), which xarray opens as it is; None for a
@@ -259,39 +235,58 @@ class Archive(ArchiveFiles):
             link = f.get(f"{study}/runs/{name}", getlink=True)
         if not isinstance(link, h5py.ExternalLink):
             return None
-        return self.data / PurePath(link.filename).name
+        return self.data / data_file_name(link.filename, f"archive {self.path}: run {run}")
 
     def study(self, name: str | None = None) -> ArchivedStudy:
         """The study as it was defined (scenes, variants, labels, description)."""
         with self._open() as f:
             name = self._study_name(f, name)
+            what = f"archive {self.path}: study {printable(name)}"
             group = f[name]
-            self._check_seal(group)
-            labels = json.loads(group.attrs["plate_labels"])
-            variants = tuple(Variant(**v) for v in json.loads(group.attrs["variants"]))
-            description = str(group.attrs["description"])
+            attributes = self._check_seal(group)
+            labels = typed.plate_labels(attributes, what)
+            variants = typed.study_variants(attributes, what)
+            description = typed.text(attributes, "description", what)
             with self._linked(f, f"{name}/scenes") as scenes:
+                size = self._scene_count(scenes)
                 columns = {
-                    k: self._read(scenes, k)
+                    k: self._read(scenes, k, "f", (size,))
                     for k in scenes
                     if k not in ("plate_label", "plate", "scene")
                 }
                 if "plate" in scenes:  # format 2: the label of each scene
-                    per_scene = tuple(str(x) for x in scenes["plate"].asstr()[()])
+                    text = self._read(scenes, "plate", "O", (size,))
+                    if not all(isinstance(x, bytes | str) for x in text):
+                        raise ArchiveError(f"{what}: its plate labels are not text")
+                    per_scene = tuple(x.decode() if isinstance(x, bytes) else x for x in text)
                 else:
-                    index = self._read(scenes, "plate_label")
+                    index = self._read(scenes, "plate_label", "iu", (size,))
+                    if size and not (0 <= index.min() and index.max() < len(labels)):
+                        raise ArchiveError(f"{what}: a plate label index is out of range")
                     per_scene = tuple(labels[i] for i in index)
-            return ArchivedStudy(name, SceneBatch(columns), variants, per_scene, description)
+            try:
+                batch = SceneBatch(columns)
+            except PlateImpactError as exc:
+                raise ArchiveError(
+                    f"{what}: its scenes are not ones this plateimpact runs ({exc})"
+                ) from None
+            return ArchivedStudy(name, batch, variants, per_scene, description)
+
+    def recorded_variant(self, run: str) -> Variant:
+        """The variant (plug-ins and settings) the run ``STUDY/RUN`` records."""
+        return typed.run_variant(
+            self._attributes(run), f"archive {self.path}: run {printable(run)}"
+        )
 
     def _study_name(self, f: h5py.File, name: str | None) -> str:
         studies = records.study_names(f)
         if name is None:
             if len(studies) != 1:
-                raise UnknownNameError(f"{self.path} holds studies {', '.join(studies)}: name one")
+                raise UnknownNameError(f"{self.path} holds studies {_listed(studies)}: name one")
             return studies[0]
         if name not in studies:
             raise UnknownNameError(
-                f"no study {name!r} in {self.path}; studies: {', '.join(studies)}"
+                f"no study {printable(name)!r} in {self.path}; studies: {_listed(studies)}"
             )
         return name
 
@@ -306,35 +301,40 @@ class Archive(ArchiveFiles):
     def metadata(self, run: str) -> dict[str, object]:
         """What the run records of how it was made (variant, model, versions, commit,
         host, times), JSON decoded; the same keys in either format version."""
-        attributes = self._attributes(self.resolve(run))
-        out: dict[str, object] = {}
-        for key, value in attributes.items():
-            if key in ("Conventions", "study", "run"):  # a data file's own labels
-                continue
-            if key in ("variant", "model", "versions", "failure_state_units"):
-                value = json.loads(str(value))
-            out[key] = value
-        return out
+        run = self.resolve(run)
+        return typed.run_metadata(
+            self._attributes(run), f"archive {self.path}: run {printable(run)}"
+        )
 
     def results(self, run: str) -> BatchResult:
         """The run's results, bit for bit as they were computed."""
         run = self.resolve(run)
         with self._open() as f:
             one = f.attrs["format_version"] == 1
+            size = self._study_size(f, run.split("/", 1)[0])  # one result per scene
             with self._linked(f, _run_path(run)) as group:
                 prefix = "results/" if one else ""
-                columns = {k: self._read(group, prefix + k) for k in RESULT_FIELDS}
+                columns = {
+                    k: self._read(group, prefix + k, "iub" if k in CODES else "f", (size,))
+                    for k in RESULT_FIELDS
+                }
+                for k, allowed in CODES.items():
+                    if not np.isin(columns[k], allowed).all():
+                        raise ArchiveError(
+                            f"archive {self.path}: run {printable(run)}: {k} holds codes other "
+                            f"than {', '.join(map(str, allowed))}; the file is damaged"
+                        )
                 columns["plate_failed"] = columns["plate_failed"].astype(bool)
                 crater, path = ("crater/", "counts") if one else ("crater_", "count")
                 craters = trajectory = None
                 if crater + path in group:
                     craters = self._read_ragged(
-                        group, crater, path, ["impact_point"], list(CRATER_FIELDS)
+                        group, crater, path, ["impact_point"], list(CRATER_FIELDS), size
                     )
                 moves = "trajectory/" if one else "trajectory_"
                 if moves + "count" in group:
                     trajectory = self._read_ragged(
-                        group, moves, "count", [], list(TRAJECTORY_FIELDS)
+                        group, moves, "count", [], list(TRAJECTORY_FIELDS), size
                     )
                 return BatchResult(columns, trajectory, craters=craters)
 
@@ -354,14 +354,24 @@ class Archive(ArchiveFiles):
                 name = name.removeprefix(f"{LIMITS}/")
             if name not in names:
                 raise UnknownNameError(
-                    f"no stored limits {name!r} in {self.path} "
-                    f"(stored: {', '.join(names) or 'none'})"
+                    f"no stored limits {printable(name)!r} in {self.path} "
+                    f"(stored: {_listed(names) or 'none'})"
                 )
             self._check_seal(f[LIMITS])
             with self._linked(f, f"{LIMITS}/{name}") as group:
                 return records.read_record(
                     group, self._check_seal, lambda path: self._read(group.file, path)
                 )
+
+
+#: Integer-coded results and the codes they may hold.
+CODES = {"outcome": [int(o) for o in Outcome], "plate_failed": [0, 1]}
+
+
+def _listed(names: list[str]) -> str:
+    """Names from an archive (maybe someone else's) for a message: inert, and not
+    endless."""
+    return printable(", ".join(names), 400)
 
 
 def _run_path(run: str) -> str:

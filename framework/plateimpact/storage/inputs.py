@@ -7,15 +7,17 @@
      "model": {"resistance": "poncelet", "resistance_version": "1.0",
                "resistance_settings": {}, "failure": ..., "integrator": "dopri5",
                "integrator_settings": {"rtol": 1e-08, ...}, "rest_speed_fraction": 0.01},
-     "versions": {"python": ..., "plateimpact": ..., ...}, "source_commit": "..."}
+     "versions": {"python": ..., "plateimpact": ..., ...}, "source_commit": "...",
+     "plugins": {"core": {...}, "resistance": {...}, ...}}  (storage.code_provenance)
 
 Every number is in the unit its key names (``_mm``, ``_g``, ``_deg``; a setting's key is
 its declaration's :attr:`~plateimpact.Parameter.key`), written as the shortest number
 that converts back to the same double (:meth:`~plateimpact.Parameter.user_number`), so
 that :func:`read_run_inputs` rebuilds the run bit for bit. A value that no number in the
 user's unit reaches (a mass computed from a density, now and then) is written in SI
-under its SI key (``mass_kg``). ``versions`` and ``source_commit`` are provenance
-(storage.provenance), not read back. The plate is a plate file's object.
+under its SI key (``mass_kg``). ``versions``, ``source_commit`` and ``plugins`` are
+provenance (storage.provenance, storage.code_provenance), not read back. The plate is
+a plate file's object.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from .plate_file import plate_from_dict
 
 FORMAT = "plateimpact-inputs-1"
 #: Keys of a record that are provenance or description, not read back.
-RECORD_ONLY = ("format", "label", "versions", "source_commit")
+RECORD_ONLY = ("format", "label", "versions", "source_commit", "plugins")
 
 
 def si_key(declared: Parameter) -> str:

@@ -7,15 +7,22 @@ Threads of one process queue on a :class:`threading.Lock`; processes on an advis
 file itself stays (deleting it would let a waiting process lock a file that no longer
 exists while a third creates a new one). It names the last writer, for messages.
 A writer that finds the archive busy waits, up to a bound, and says so once.
+
+The lock file may have come with the archive (a tarball holding ``ARCHIVE.lock``), so
+it is opened without following a symlink (``O_NOFOLLOW``) and written only once
+``fstat`` shows a regular file with one link: a shipped ``a.h5.lock -> ~/notes.txt``,
+or a hard link to the notes, is refused with one line and never written.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import math
 import os
 import socket
+import stat
 import threading
 import time
 import warnings
@@ -23,6 +30,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..errors import ArchiveError, ArchiveWaitWarning
+from .untrusted import printable
 
 #: How often a waiting writer looks again [s].
 POLL = 0.05
@@ -44,20 +52,40 @@ def _thread_lock(real: Path) -> threading.Lock:
         return _THREAD_LOCKS.setdefault(real, threading.Lock())
 
 
-def holder(lock_path: Path) -> str:
-    """Who last took the lock, as the lock file says ("process 123 on host")."""
+def holder(fd: int) -> str:
+    """Who last took the lock, as the open lock file says ("process 123 on host")."""
     try:
-        pid, host = lock_path.read_text().split()[:2]
-        return f"process {int(pid)} on {host}"
+        pid, host = os.pread(fd, 256, 0).decode().split()[:2]
+        return f"process {int(pid)} on {printable(host, 64)}"
     except (OSError, ValueError):
         return "another writer"
 
 
+def _open_lock(lock_path: Path, flags: int) -> int:
+    """The lock file, opened without following a link and checked, on the descriptor,
+    to be a regular file with one link (OSError if it cannot be opened, ArchiveError if
+    it is not one we may write)."""
+    fd = os.open(lock_path, flags | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, 0o644)
+    status = os.fstat(fd)
+    if not stat.S_ISREG(status.st_mode) or status.st_nlink != 1:
+        os.close(fd)
+        what = (
+            "a second name (hard link) of another file"
+            if stat.S_ISREG(status.st_mode)
+            else ("not a regular file")
+        )
+        raise ArchiveError(
+            f"the lock file {lock_path} is {what}; refusing to write it (remove it: an "
+            "archive's lock is an ordinary file of its own)"
+        )
+    return fd
+
+
 def busy(lock_path: Path) -> bool:
-    """Whether a live writer holds the lock (never blocks)."""
+    """Whether a live writer holds the lock (never blocks, never follows a link)."""
     try:
-        fd = os.open(lock_path, os.O_RDONLY)
-    except OSError:
+        fd = _open_lock(lock_path, os.O_RDONLY)
+    except (OSError, ArchiveError):
         return False
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
@@ -86,11 +114,15 @@ def locked(path: Path, real: Path, lock_path: Path, wait: float) -> Iterator[Non
             )
     try:
         try:
-            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+            fd = _open_lock(lock_path, os.O_RDWR | os.O_CREAT)
         except OSError as exc:
+            symlink = exc.errno == errno.ELOOP
+            reason = "it is a symbolic link; refusing to follow it" if symlink else exc.strerror
             raise ArchiveError(
-                f"archive {path}: cannot open its lock {lock_path}: {exc.strerror}"
+                f"archive {path}: cannot open its lock {lock_path}: {reason}"
             ) from None
+        except ArchiveError as exc:
+            raise ArchiveError(f"archive {path}: {exc}") from None
         try:
             announced = False
             while True:
@@ -100,15 +132,16 @@ def locked(path: Path, real: Path, lock_path: Path, wait: float) -> Iterator[Non
                 except BlockingIOError:
                     if time.monotonic() >= deadline:
                         raise ArchiveBusyError(
-                            f"archive {path} stayed busy ({holder(lock_path)} writing it) for "
+                            f"archive {path} stayed busy ({holder(fd)} writing it) for "
                             f"{wait:g} s{WAIT_SETTING}"
                         ) from None
                     if not announced:
-                        _announce(path, holder(lock_path))
+                        _announce(path, holder(fd))
                         announced = True
                     time.sleep(POLL)
-            os.ftruncate(fd, 0)
-            os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+            with contextlib.suppress(OSError):  # who holds it, for messages: a full disk
+                os.ftruncate(fd, 0)  # must not keep a writer from the lock it holds
+                os.pwrite(fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
             yield
         finally:
             os.close(fd)  # releases the flock

@@ -14,18 +14,19 @@ attributes are sealed by their SHA-256 as in format 1.
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, BinaryIO
 
 import h5py
 import numpy as np
 
+from ..errors import ArchiveError
 from ..parameters import Parameter
 from ..ragged import Ragged
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
 from .hdf5 import digest
+from .untrusted import load_json
 
 SCENE, SAMPLE, POINT = "scene", "trajectory_sample", "crater_point"
 #: The per-scene label of the plate, a string coordinate.
@@ -116,15 +117,17 @@ def trajectory_field(name: str, state_units: Mapping[str, str]) -> Parameter:
 
 
 def write_run_file(
-    path: str | os.PathLike[str],
+    path: str | os.PathLike[str] | BinaryIO,
     columns: Mapping[str, np.ndarray],
     declared: Mapping[str, Parameter],
     plate_labels: Sequence[str],
     result: BatchResult,
     attributes: Mapping[str, object],
 ) -> None:
-    """One run as a netCDF-4 file at ``path``: the scenes as coordinates, the results as
-    variables over ``scene``, the ragged arrays, and ``attributes`` (sealed)."""
+    """One run as a netCDF-4 file at ``path`` (a file object: archives write in memory):
+    the scenes as coordinates, the results as variables over ``scene``, the ragged
+    arrays, and ``attributes`` (sealed; ``failure_state_units`` may come from an archive,
+    so it is read as untrusted JSON)."""
     import h5netcdf  # noqa: PLC0415 (only archives need it)
 
     with h5netcdf.File(path, "w") as f:
@@ -133,7 +136,13 @@ def write_run_file(
             variable = _variable(f, name, (SCENE,), result.columns[name], field)
             variable.attrs["coordinates"] = coordinates
         if result.trajectory is not None:
-            units = json.loads(str(attributes.get("failure_state_units", "{}")))
+            units = load_json(
+                str(attributes.get("failure_state_units", "{}")),
+                "attribute failure_state_units",
+                ArchiveError,
+            )
+            if not isinstance(units, dict) or not all(isinstance(u, str) for u in units.values()):
+                raise ArchiveError("attribute failure_state_units is not an object of unit names")
             fields = {k: trajectory_field(k, units) for k in result.trajectory.values}
             write_ragged(f, "trajectory", SAMPLE, result.trajectory, fields)
         if result.craters is not None:
@@ -142,7 +151,7 @@ def write_run_file(
 
 
 def write_scenes_file(
-    path: str | os.PathLike[str],
+    path: str | os.PathLike[str] | BinaryIO,
     columns: Mapping[str, np.ndarray],
     declared: Mapping[str, Parameter],
     plate_labels: Sequence[str],

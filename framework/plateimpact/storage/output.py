@@ -17,6 +17,7 @@ import contextlib
 import errno
 import glob
 import os
+import re
 import stat
 import tempfile
 from collections.abc import Callable, Iterable
@@ -37,6 +38,9 @@ SUFFIXES: dict[str, tuple[str, ...] | None] = {
 #: meets any journal's line-art rule, and there the 8 x 25 in outcome maps of
 #: ``reproduce`` are 290 megapixels (1.8 GB, 50 s). Print wants SVG or PDF anyway.
 FIGURE_DPI = 150.0
+#: What a temporary's name adds to its target's: ``.`` and ``.PID.XXXXXXXX.tmp``, the PID
+#: up to 7 digits (Linux's largest pid_max, 2**22) [bytes].
+TEMPORARY_EXTRA = 1 + 1 + 7 + 1 + 8 + 4
 FIGURE_DPI_RANGE = (50.0, 1200.0)
 
 
@@ -69,13 +73,40 @@ def umask() -> int:
     return current
 
 
+def path_max(directory: str | os.PathLike[str]) -> int:
+    """The longest path the system takes in ``directory`` [bytes, with its NUL]."""
+    try:
+        return os.pathconf(directory, "PC_PATH_MAX")
+    except (OSError, ValueError):
+        return 4096
+
+
+def unwritable(directory: str | os.PathLike[str]) -> str:
+    """Why a directory is not writable: a read-only filesystem, or its permissions."""
+    with contextlib.suppress(OSError):
+        if os.statvfs(directory).f_flag & os.ST_RDONLY:
+            return "not writable (a read-only filesystem)"
+    return "not writable"
+
+
 def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> Path:
     """The real file ``path`` names (links followed), after refusing what cannot be
     written there. Call it before any computation."""
     text = os.fspath(path)
     if not text.strip():
         raise OutputError(f"{flag}: give a file name, got {text!r}")
+    longest = path_max("/") - 1 - TEMPORARY_EXTRA  # with its NUL, and its temporary's name
+    if len(os.fsencode(text)) > longest:
+        raise OutputError(
+            f"{flag}: the path is {len(os.fsencode(text)):,} bytes; at most {longest:,} are "
+            f"written (PATH_MAX {path_max('/')})"
+        )
     real = Path(os.path.realpath(text))
+    if len(os.fsencode(real)) > longest:
+        raise OutputError(
+            f"{flag}: the path leads to {len(os.fsencode(real)):,} bytes; at most {longest:,} "
+            f"are written (PATH_MAX {path_max('/')})"
+        )
     directory = str(real.parent)
     if os.path.isdir(directory) and len(real.name.encode()) > _name_max(directory):
         raise OutputError(f"{flag}: the file name is longer than {_name_max(directory)} bytes")
@@ -84,7 +115,7 @@ def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> 
     if not os.path.isdir(directory):
         raise OutputError(f"{flag}: directory {directory!r} does not exist")
     if not os.access(directory, os.W_OK | os.X_OK):
-        raise OutputError(f"{flag}: directory {directory!r} is not writable")
+        raise OutputError(f"{flag}: directory {directory!r} is {unwritable(directory)}")
     if real.exists() or real.is_symlink():
         try:
             mode = os.stat(real).st_mode
@@ -172,13 +203,26 @@ def pid_alive(pid: int) -> bool:
     return True
 
 
+def temporary_owner(name: str, target: str) -> int | None:
+    """The process that made the temporary ``name`` of ``target``, if ``name`` parses
+    exactly as one (``.TARGET.PID.XXXXXXXX.tmp``, 8 characters of ``tempfile``'s or
+    hexadecimal digits); None otherwise (another file's: the temporaries of ``a`` and of
+    ``a.4194303`` both start with ``.a.``)."""
+    prefix = f".{target}."
+    if not (name.startswith(prefix) and name.endswith(".tmp")):
+        return None
+    found = re.fullmatch(r"([0-9]{1,10})\.[a-z0-9_]{8}", name[len(prefix) : -len(".tmp")])
+    return int(found.group(1)) if found else None
+
+
 def remove_dead_temporaries(target: Path) -> None:
     """Delete the temporary files of writers of ``target`` that were killed mid-write
-    (``.NAME.PID.XXXX.tmp`` whose process is gone)."""
+    (``.NAME.PID.XXXX.tmp`` whose process is gone; regular files only, never a link)."""
     for temporary in target.parent.glob(f".{glob.escape(target.name)}.*.tmp"):
-        pid = temporary.name[len(target.name) + 2 :].split(".")[0]
-        if pid.isdigit() and not pid_alive(int(pid)):
-            temporary.unlink(missing_ok=True)
+        pid = temporary_owner(temporary.name, target.name)
+        if pid is not None and not pid_alive(pid) and temporary.is_file():
+            if not temporary.is_symlink():
+                temporary.unlink(missing_ok=True)
 
 
 def keep_mode(temporary: str, target: Path) -> None:

@@ -24,6 +24,7 @@ from ..parameters import Parameter
 from ..simulation import Simulation
 from ..variant import Variant
 from . import inputs
+from .code_provenance import plugins_record
 from .plate_file import plate_to_dict
 
 PACKAGES = ("plateimpact", "numpy", "scipy", "attrs", "pluggy", "h5py")
@@ -161,10 +162,11 @@ def inputs_record(
     **extra: object,
 ) -> dict[str, Any]:
     """Every input of a run, in user units, and where the code came from (storage.inputs:
-    the format; ``run --inputs`` reads it back). ``scene`` gives values [SI] by
-    declaration (impact speed and obliquity of one scene); ``extra`` adds keys as they
-    are (a sweep's grid as typed). Without a sphere and plate (a study's runs, whose
-    scenes are stored beside them): the model and provenance only."""
+    the format; ``run --inputs`` reads it back; ``plugins``: storage.code_provenance).
+    ``scene`` gives values [SI] by declaration (impact speed and obliquity of one
+    scene); ``extra`` adds keys as they are (a sweep's grid as typed). Without a sphere
+    and plate (a study's runs, whose scenes are stored beside them): the model and
+    provenance only."""
     record: dict[str, Any] = {"format": inputs.FORMAT}
     if label is not None:
         record["label"] = label
@@ -179,6 +181,7 @@ def inputs_record(
     record["model"] = inputs.model_record(simulation)
     record["versions"] = versions()
     record["source_commit"] = source_commit()
+    record["plugins"] = plugins_record(simulation)
     return record
 
 
@@ -188,6 +191,7 @@ class RunMetadata:
     def __init__(self, variant: Variant, simulation: Simulation) -> None:
         self.variant = variant
         self.model = simulation.describe()
+        self.plugins = plugins_record(simulation)
         self.state_names = simulation.model.failure.state_names
         self.state_units = simulation.model.failure.state_units
         self.start = dt.datetime.now(dt.UTC)
@@ -205,6 +209,7 @@ class RunMetadata:
             "model": json.dumps(self.model, sort_keys=True),
             "versions": json.dumps(versions(), sort_keys=True),
             "git_commit": git_commit(),
+            "plugins": json.dumps(self.plugins, sort_keys=True),
             "host": socket.gethostname(),
             "start_time": self.start.isoformat(),
             "end_time": self.end.isoformat(),

@@ -13,14 +13,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
 
 import attrs
 import h5py
 import numpy as np
 
 from ..errors import ArchiveError, ParameterError
-from .append import DataFiles, append_with
+from .append import append_with
+from .data_files import DataFiles
 from .hdf5 import seal, write_dataset
+from .untrusted import printable
 
 #: The top-level group of the stored records; a study may not take its name.
 LIMITS = "limits"
@@ -56,8 +59,23 @@ def is_container(f: h5py.File, name: str) -> bool:
 
 
 def study_names(f: h5py.File) -> list[str]:
-    """The archive's studies: its top-level groups but the records' one."""
-    return [name for name in f if not is_container(f, name)]
+    """The archive's studies: its top-level groups but the records' one (anything else
+    at the top, or a study whose runs are not a group, is damage)."""
+    names = []
+    for name in f:
+        if not isinstance(f.get(name), h5py.Group):
+            raise ArchiveError(
+                f"{f.filename}: /{printable(name, 80)} is not a group; the archive is damaged"
+            )
+        if not is_container(f, name):
+            runs = f[name].get("runs")
+            if runs is not None and not isinstance(runs, h5py.Group):
+                raise ArchiveError(
+                    f"{f.filename}: /{printable(name, 80)}/runs is not a group; the archive "
+                    "is damaged"
+                )
+            names.append(name)
+    return names
 
 
 def check_study_name(name: str, path: Path) -> None:
@@ -104,6 +122,8 @@ def write_record(
         seal(container)
     container = f[LIMITS]
     stored, k = name, 1
+    if not isinstance(container, h5py.Group):
+        raise ArchiveError(f"archive {path}: /{LIMITS} is not a group; the archive is damaged")
     if overwrite and name in container:
         old = container.get(name, getlink=True)
         if isinstance(old, h5py.ExternalLink):
@@ -112,13 +132,14 @@ def write_record(
     while stored in container:
         k += 1
         stored = f"{name}.{k}"
-    target = files.new(f"{LIMITS}.{stored}", lambda where: write_record_file(where, record))
+    target = files.new(f"{LIMITS}.{stored}", lambda handle: write_record_file(handle, record))
     container[stored] = h5py.ExternalLink(target, "/")
     return stored
 
 
-def write_record_file(where: Path, record: Record) -> None:
-    """The record's own HDF5 file: sealed attributes at its root, then its datasets."""
+def write_record_file(where: BinaryIO, record: Record) -> None:
+    """The record's own HDF5 file (into a file object: archives write in memory): sealed
+    attributes at its root, then its datasets."""
     with h5py.File(where, "w") as group:
         for key, value in record.attributes.items():
             group.attrs[key] = value

@@ -1,8 +1,8 @@
 """The columns of a shot file and the checks of one row (for :mod:`.shots`).
 
 Each row is read into user units and checked on its own; a bad value raises
-:class:`BadValue` naming the column, which the reader turns into one line naming the
-file, line, column and value (and how many more rows are bad).
+:class:`BadValue` naming the column, which the reader (:mod:`.shot_reader`) turns into
+one line naming the file, line, column and value (and how many more rows are bad).
 """
 
 from __future__ import annotations
@@ -40,6 +40,11 @@ COLUMNS = (
     "weight",
     "source",
 )
+#: The keys of the checked columns, once (each row reads them; ``Parameter.key`` builds
+#: its string on every call).
+SPEED_KEY, OBLIQUITY_KEY = REQUIRED_COLUMNS
+RESIDUAL_KEY, EXIT_KEY = RESIDUAL_SPEED.key, RESULT_FIELDS["exit_obliquity"].key
+_RANGES = {declared.name: (declared.key, declared.describe_range()) for declared in (RADIUS, MASS)}
 #: How the ``perforated`` column may say yes and no.
 PERFORATED_WORDS = {"1": True, "0": False, "true": True, "false": False}
 _OUTCOMES = {o.label: o for o in Outcome}
@@ -116,13 +121,19 @@ def _finite(row: Mapping[str, object], column: str, *, optional: bool = True) ->
     return x
 
 
+def _inside(declared: Parameter, x: float) -> bool:
+    """Whether ``x`` [SI], finite, lies in ``declared``'s range (a scalar Range.contains)."""
+    r = declared.range
+    above = x > r.low if r.low_open else x >= r.low
+    return above and (x < r.high if r.high_open else x <= r.high)
+
+
 def _in_range(row: Mapping[str, object], declared: Parameter) -> float:
     """An optional number in ``declared``'s range (user units), NaN if blank."""
-    x = _finite(row, declared.key)
-    if not math.isnan(x) and not declared.range.contains(x * declared.scale):
-        raise BadValue(
-            declared.key, f"must be {declared.describe_range()}, got {row[declared.key]!r}"
-        )
+    key, allowed = _RANGES[declared.name]
+    x = _finite(row, key)
+    if not math.isnan(x) and not _inside(declared, x * declared.scale):
+        raise BadValue(key, f"must be {allowed}, got {row[key]!r}")
     return x
 
 
@@ -187,29 +198,26 @@ def _perforation(row: Mapping[str, object], outcome: int, residual: float) -> bo
 
 def check_row(row: Mapping[str, object]) -> ShotRow:
     """One row (column name -> number or string, user units) checked; BadValue if bad."""
-    speed = _finite(row, IMPACT_SPEED.key, optional=False)
-    if not IMPACT_SPEED.range.contains(speed):
-        raw = row[IMPACT_SPEED.key]
-        raise BadValue(IMPACT_SPEED.key, f"must be {IMPACT_SPEED.describe_range()}, got {raw!r}")
-    obliquity = _finite(row, IMPACT_OBLIQUITY.key, optional=False)
+    speed = _finite(row, SPEED_KEY, optional=False)
+    if not _inside(IMPACT_SPEED, speed):
+        raw = row[SPEED_KEY]
+        raise BadValue(SPEED_KEY, f"must be {IMPACT_SPEED.describe_range()}, got {raw!r}")
+    obliquity = _finite(row, OBLIQUITY_KEY, optional=False)
     if not 0.0 <= obliquity < 90.0:
-        raw = row[IMPACT_OBLIQUITY.key]
-        raise BadValue(IMPACT_OBLIQUITY.key, f"must be in [0, 90) deg, got {raw!r}")
-    residual = _finite(row, RESIDUAL_SPEED.key)
+        raise BadValue(OBLIQUITY_KEY, f"must be in [0, 90) deg, got {row[OBLIQUITY_KEY]!r}")
+    residual = _finite(row, RESIDUAL_KEY)
     if residual < 0.0:
         raise BadValue(
-            RESIDUAL_SPEED.key,
-            f"must be >= 0 m/s (0: no perforation), got {row[RESIDUAL_SPEED.key]!r}",
+            RESIDUAL_KEY, f"must be >= 0 m/s (0: no perforation), got {row[RESIDUAL_KEY]!r}"
         )
     if residual > speed:
         raise BadValue(
-            RESIDUAL_SPEED.key,
-            f"must not exceed the impact speed {speed:g} m/s, got {row[RESIDUAL_SPEED.key]!r}",
+            RESIDUAL_KEY,
+            f"must not exceed the impact speed {speed:g} m/s, got {row[RESIDUAL_KEY]!r}",
         )
-    exit_key = RESULT_FIELDS["exit_obliquity"].key
-    exit_obliquity = _finite(row, exit_key)
+    exit_obliquity = _finite(row, EXIT_KEY)
     if not math.isnan(exit_obliquity) and not 0.0 <= exit_obliquity <= 180.0:
-        raise BadValue(exit_key, f"must be in [0, 180] deg, got {row[exit_key]!r}")
+        raise BadValue(EXIT_KEY, f"must be in [0, 180] deg, got {row[EXIT_KEY]!r}")
     outcome = _outcome(row)
     perforated = _perforation(row, outcome, residual)
     weight = _finite(row, "weight")
@@ -228,21 +236,3 @@ def check_row(row: Mapping[str, object]) -> ShotRow:
         weight=1.0 if math.isnan(weight) else weight,
         note="" if _is_blank(note) else str(note).strip(),
     )
-
-
-def check_rows(
-    rows: Sequence[Mapping[str, object]], labels: Sequence[str], source: str
-) -> list[ShotRow]:
-    """Every row checked; one :class:`ShotDataError` line for the first bad one."""
-    if not rows:
-        raise ShotDataError(f"{source}: no shots after the header")
-    checked, problems = [], []
-    for label, row in zip(labels, rows, strict=True):
-        try:
-            checked.append(check_row(row))
-        except BadValue as bad:
-            problems.append(f"{label}, column {bad.column}: {bad.problem}")
-    if problems:
-        more = f" (and {len(problems) - 1} more bad rows)" if len(problems) > 1 else ""
-        raise ShotDataError(problems[0] + more)
-    return checked

@@ -11,10 +11,11 @@ free-text source. The CSV header names the columns, in any order:
 
 with at least one of ``outcome``, ``perforated`` and ``residual_speed_m_s``. Lines
 starting with ``#`` are comments; other columns are ignored; a UTF-8 byte order mark and
-CRLF line ends are read. Every bad value raises :class:`~plateimpact.errors.ShotDataError`
-with one line naming the file, line, column and value (and how many more rows are bad);
-what the outcome, ``perforated`` and residual speed say must agree (docs/calibration.md,
-"1. Shot data").
+CRLF line ends are read. The file is read a row at a time (:mod:`.shot_reader`): the
+first bad value raises :class:`~plateimpact.errors.ShotDataError` at once, with one line
+naming the file, line, column and value (and how many of the next 10,000 rows are bad);
+what the outcome, ``perforated`` and residual speed say must agree; a set holds at most
+:data:`MAX_SHOTS` shots (docs/calibration.md, "1. Shot data").
 """
 
 from __future__ import annotations
@@ -34,17 +35,26 @@ from ..errors import ParameterError, ShotDataError
 from ..parameters import Parameter
 from ..results import RESULT_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY
-from .shot_rows import (
-    COLUMNS,
-    PERFORATION_COLUMNS,
-    REQUIRED_COLUMNS,
-    RESIDUAL_SPEED,
-    ShotRow,
-    check_columns,
-    check_rows,
+from .shot_reader import (
+    MAX_SHOTS,
+    ShotColumns,
+    ShotLabels,
+    check_all,
+    check_count,
+    column_records,
+    csv_records,
 )
+from .shot_rows import COLUMNS, PERFORATION_COLUMNS, REQUIRED_COLUMNS, RESIDUAL_SPEED, check_columns
 
-__all__ = ["COLUMNS", "PERFORATION_COLUMNS", "REQUIRED_COLUMNS", "RESIDUAL_SPEED", "Shots"]
+__all__ = [
+    "COLUMNS",
+    "MAX_SHOTS",
+    "PERFORATION_COLUMNS",
+    "REQUIRED_COLUMNS",
+    "RESIDUAL_SPEED",
+    "ShotLabels",
+    "Shots",
+]
 
 EXIT_OBLIQUITY = RESULT_FIELDS["exit_obliquity"]
 
@@ -71,8 +81,9 @@ class Shots:
         [rad], NaN where not recorded.
     outcome : numpy.ndarray
         :class:`~plateimpact.Outcome` values, 0 where only go/no-go is known.
-    labels : tuple of str
-        Where each shot came from (``shots.csv line 7``), for error messages.
+    labels : sequence of str
+        Where each shot came from (``shots.csv line 7``), for error messages: a tuple, or
+        from a file a :class:`ShotLabels` (line numbers, each label made when asked).
     source : str
         The file (or ``"shots"``), for error messages about the whole set.
     perforated : numpy.ndarray
@@ -92,7 +103,7 @@ class Shots:
     residual_speed: np.ndarray
     exit_obliquity: np.ndarray
     outcome: np.ndarray
-    labels: tuple[str, ...]
+    labels: Sequence[str]
     source: str = "shots"
     perforated: np.ndarray = attrs.field(kw_only=True)
     radius: np.ndarray = attrs.field(kw_only=True, default=attrs.Factory(_nan_like, True))
@@ -126,6 +137,7 @@ class Shots:
             raise ShotDataError(
                 f"{self.source}: {len(self)} impact speeds but {wrong} (one entry per shot)"
             )
+        check_count(self.source, len(self))
 
     def __len__(self) -> int:
         return int(np.size(self.impact_speed))
@@ -139,7 +151,7 @@ class Shots:
             self.residual_speed[kept],
             self.exit_obliquity[kept],
             self.outcome[kept],
-            tuple(self.labels[i] for i in kept),
+            _take_labels(self.labels, kept),
             self.source,
             perforated=self.perforated[kept],
             radius=self.radius[kept],
@@ -153,10 +165,14 @@ class Shots:
         return self.take(self.impact_obliquity == 0.0)
 
     def groups_by_obliquity(self) -> dict[float, Shots]:
-        """The shots of each impact obliquity [rad], in increasing obliquity."""
+        """The shots of each impact obliquity [rad], in increasing obliquity (each group
+        in file order; one sort, however many obliquities)."""
+        obliquities, group = np.unique(self.impact_obliquity, return_inverse=True)
+        order = np.argsort(group.reshape(-1), kind="stable")
+        starts = np.searchsorted(group.reshape(-1)[order], np.arange(obliquities.size + 1))
         return {
-            float(obliquity): self.take(self.impact_obliquity == obliquity)
-            for obliquity in np.unique(self.impact_obliquity)
+            float(obliquity): self.take(order[starts[k] : starts[k + 1]])
+            for k, obliquity in enumerate(obliquities)
         }
 
     def spheres(self, sphere: Sphere) -> tuple[np.ndarray, np.ndarray]:
@@ -200,50 +216,27 @@ class Shots:
         lengths = {len(values) for values in columns.values()}
         if len(lengths) > 1:
             raise ShotDataError(f"{source}: columns differ in length: {sorted(lengths)}")
-        count = lengths.pop() if lengths else 0
+        check_count(source, lengths.pop() if lengths else 0)
         check_columns(source, list(columns))
-        rows = [{name: columns[name][i] for name in columns} for i in range(count)]
-        labels = [f"{source} row {i}" for i in range(count)]
-        return _of_rows(check_rows(rows, labels, source), labels, source)
+        return _of_rows(check_all(column_records(columns), source, "row"), source, "row")
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str]) -> Shots:
-        """Shots from a CSV file (see the module's description of the columns)."""
+        """Shots from a CSV file (see the module's description of the columns), read a
+        row at a time."""
         source = os.fspath(path)
         try:
             with open(source, encoding="utf-8-sig", newline="") as handle:  # BOM allowed
-                text = handle.read()
+                return _of_rows(check_all(csv_records(handle, source), source, "line"), source)
         except (OSError, UnicodeDecodeError) as exc:
             reason = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
             raise ShotDataError(f"{source}: cannot read: {reason}") from None
-        return cls.from_csv_text(text, source=source)
 
     @classmethod
     def from_csv_text(cls, text: str, *, source: str = "shots") -> Shots:
         """Shots from the text of a CSV file; ``source`` names it in error messages."""
-        lines = [
-            (number, line)
-            for number, line in enumerate(text.removeprefix("\ufeff").splitlines(), start=1)
-            if line.strip() and not line.lstrip().startswith("#")
-        ]
-        if not lines:
-            raise ShotDataError(
-                f"{source}: empty file, expected a header naming {', '.join(REQUIRED_COLUMNS)} "
-                f"and one of {', '.join(PERFORATION_COLUMNS)}"
-            )
-        records = list(csv.reader(line for _, line in lines))
-        header = [name.strip() for name in records[0]]
-        check_columns(f"{source} line {lines[0][0]}", header)
-        rows, labels = [], []
-        for (number, _), record in zip(lines[1:], records[1:], strict=True):
-            if len(record) != len(header):
-                raise ShotDataError(
-                    f"{source} line {number}: expected {len(header)} fields as in the "
-                    f"header, got {len(record)}"
-                )
-            rows.append(dict(zip(header, record, strict=True)))
-            labels.append(f"{source} line {number}")
-        return _of_rows(check_rows(rows, labels, source), labels, source)
+        handle = io.StringIO(text.removeprefix("\ufeff"), newline="")
+        return _of_rows(check_all(csv_records(handle, source), source, "line"), source)
 
     def to_csv_text(self, comments: Sequence[str] = ()) -> str:
         """The shots as CSV in user units, ``# comment`` lines first: the columns that
@@ -293,21 +286,26 @@ def _exact(value: float, declared: Parameter | None = None) -> str:
     return repr(number if number is not None else value / declared.scale)
 
 
-def _of_rows(rows: Sequence[ShotRow], labels: Sequence[str], source: str) -> Shots:
-    def column(name: str) -> np.ndarray:
-        return np.array([getattr(row, name) for row in rows], dtype=float)
+def _take_labels(labels: Sequence[str], kept: np.ndarray) -> Sequence[str]:
+    if isinstance(labels, ShotLabels):
+        return labels.take(kept)
+    return tuple(labels[i] for i in kept)
 
+
+def _of_rows(columns: ShotColumns, source: str, word: str = "line") -> Shots:
+    """Shots in SI units from checked rows in user units."""
+    found = columns.arrays()
     return Shots(
-        impact_speed=column("impact_speed"),
-        impact_obliquity=column("impact_obliquity") * IMPACT_OBLIQUITY.scale,
-        residual_speed=column("residual_speed"),
-        exit_obliquity=column("exit_obliquity") * EXIT_OBLIQUITY.scale,
-        outcome=column("outcome").astype(int),
-        labels=tuple(labels),
+        impact_speed=found["impact_speed"],
+        impact_obliquity=found["impact_obliquity"] * IMPACT_OBLIQUITY.scale,
+        residual_speed=found["residual_speed"],
+        exit_obliquity=found["exit_obliquity"] * EXIT_OBLIQUITY.scale,
+        outcome=found["outcome"],
+        labels=ShotLabels(source, np.array(columns.numbers, dtype=np.int64), word),
         source=source,
-        perforated=column("perforated").astype(bool),
-        radius=column("radius") * RADIUS.scale,
-        mass=column("mass") * MASS.scale,
-        weight=column("weight"),
-        notes=tuple(row.note for row in rows),
+        perforated=found["perforated"],
+        radius=found["radius"] * RADIUS.scale,
+        mass=found["mass"] * MASS.scale,
+        weight=found["weight"],
+        notes=tuple(columns.notes),
     )

@@ -15,16 +15,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from .bootstrap import bootstrap_intervals
-from .likelihood import (
-    PROBIT,
-    check_arrays,
-    check_shots,
-    increasing,
-    link_of,
-    maximum,
-    prepared,
-)
+from .likelihood import PROBIT, check_arrays, check_shots, increasing, link_of, prepared, rounds
 from .profile import Interval, profile_intervals
+from .solver import maximum
 
 #: The quantiles reported, by name: the speed at which P(perforation) is p.
 LEVELS = {"v50": 0.5, "v10": 0.1, "v90": 0.9}
@@ -43,12 +36,15 @@ class V50Fit:
     fitted curve. Each ``*_ci_m_s`` is the profile-likelihood interval [low, high] at
     ``confidence``, each ``*_bootstrap_ci_m_s`` the parametric-bootstrap percentile
     interval of ``bootstrap_resamples`` resamples (None if 0), of which
-    ``bootstrap_separated`` had outcomes that did not overlap and ``bootstrap_flat`` no
-    rise of perforation with speed (plateimpact.v50.bootstrap). An interval end is
+    ``bootstrap_separated`` had outcomes that did not overlap, ``bootstrap_flat`` no
+    rise of perforation with speed, and ``bootstrap_failed`` no fit any solver converged
+    on (left out; none is known) (plateimpact.v50.bootstrap). An interval end is
     None where the data do not bound it (for a speed: above 0 m/s). ``mixed_zone_m_s`` is
-    [the slowest perforation, the fastest non-perforation]. ``fit_v50`` raises rather
-    than return a fit that did not converge, so ``converged`` is True on every fit it
-    returns.
+    [the slowest perforation, the fastest non-perforation]. ``rounds`` (also ``shots``)
+    counts the shots with their weights (a row of weight w is w shots), ``perforations``
+    the perforating ones; ``rows`` the rows of positive weight. ``fit_v50`` raises
+    rather than return a fit that did not converge, so ``converged`` is True on every fit
+    it returns.
     """
 
     method: str
@@ -69,8 +65,11 @@ class V50Fit:
     bootstrap_resamples: int
     bootstrap_separated: int
     bootstrap_flat: int
-    shots: int
-    perforations: int
+    bootstrap_failed: int
+    shots: int | float
+    perforations: int | float
+    rounds: int | float
+    rows: int
     mixed_zone_m_s: tuple[float, float]
     log_likelihood: float
     iterations: int
@@ -124,16 +123,22 @@ def fit_v50(
     default 1) have one value per shot. ``method`` is ``probit`` (F = Φ) or ``logit``
     (the logistic CDF). ``confidence`` sets the intervals' level; ``bootstrap``
     resamples (0: none) are drawn with ``rng`` (a Generator, or a seed: the default 0
-    makes a fit reproducible). ``label`` names the shots in error messages.
+    makes a fit reproducible). ``label`` names the shots in error messages. The shots
+    are taken in one order (by speed, outcome, weight), so the fit and its bootstrap do
+    not depend on the order given.
 
-    Raises :class:`~plateimpact.errors.V50Error` (one line) for fewer than 4 shots, only
-    one outcome, no overlap of the outcomes' speeds (the likelihood has no maximum), a
-    fit that finds perforation less likely at higher speeds, or one that does not
-    converge; :class:`~plateimpact.errors.ParameterError` for bad arguments.
+    Raises :class:`~plateimpact.errors.V50Error` (one line) for fewer than 4 shots
+    (weights counted), only one outcome, outcomes separated by a speed (the likelihood
+    has no maximum), or a fit that finds perforation less likely at higher speeds (a
+    fit that does not converge would be refused too: none is known);
+    :class:`~plateimpact.errors.ParameterError` for bad arguments.
     """
     link = link_of(method)
     _check_options(confidence, bootstrap)
     v, y, w = check_arrays(speed, perforated, weight)
+    # One order whatever the file's: the same numbers, bootstrap draws included.
+    order = np.lexsort((w, y, v))
+    v, y, w = v[order], y[order], w[order]
     check_shots(v, y, w, label)
     shots = prepared(v, y, w)
     best = increasing(maximum(shots, link, label), label)
@@ -145,6 +150,7 @@ def fit_v50(
         v, y, w, link, (point["v50"], scale), bootstrap, rng, confidence, LEVELS
     )
     used = w > 0
+    count = rounds(w[used])
     return V50Fit(
         method=link.name,
         v50_m_s=point["v50"],
@@ -164,8 +170,11 @@ def fit_v50(
         bootstrap_resamples=bootstrap,
         bootstrap_separated=resampled.separated,
         bootstrap_flat=resampled.flat,
-        shots=int(used.sum()),
-        perforations=int((used & y).sum()),
+        bootstrap_failed=resampled.failed,
+        shots=count,
+        perforations=rounds(w[used & y]),
+        rounds=count,
+        rows=int(used.sum()),
         mixed_zone_m_s=(float(v[used & y].min()), float(v[used & ~y].max())),
         log_likelihood=-best.negative_log_likelihood,
         iterations=best.iterations,

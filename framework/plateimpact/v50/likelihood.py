@@ -10,10 +10,13 @@ with F = Φ (probit; s is the normal's standard deviation σ) or the logistic CD
 1/(1 + e^−z) (logit; s is its scale, its standard deviation σ = s π/√3). In the linear
 form z = β0 + β1 x of a binomial GLM, x = (v − c)/d the speeds centred and scaled, −log L
 is convex in (β0, β1) (F is log-concave), so its maximum is unique where it exists;
-scipy's trust-region solver finds it from the exact gradient and Hessian written below.
-It exists if and only if the speeds of the two outcomes overlap (the highest
-non-perforation is faster than the lowest perforation): otherwise s → 0 and no finite
-maximum is reached (quasi-complete separation), which :func:`check_shots` refuses.
+plateimpact.v50.solver finds it from the exact gradient and Hessian written below.
+It exists if and only if the speeds of the two outcomes overlap both ways (the highest
+non-perforation is faster than the lowest perforation, and the highest perforation
+faster than the lowest non-perforation): otherwise the outcomes are separated by a speed
+and the likelihood climbs without bound as the curve steepens into a step there
+(quasi-complete separation), which :func:`check_shots` refuses: rising, s → 0; falling,
+no ballistic limit at all.
 """
 
 from __future__ import annotations
@@ -23,18 +26,19 @@ from collections.abc import Callable
 
 import attrs
 import numpy as np
-from scipy import optimize, special
+from scipy import special
 
 from ..errors import ParameterError, V50Error
 
 #: The fits, by name.
 PROBIT, LOGIT = "probit", "logit"
 METHODS = (PROBIT, LOGIT)
-#: Fewest shots (of positive weight) a fit takes: two parameters and something left over.
+#: Fewest shots (rounds: weights counted) a fit takes: two parameters and something left
+#: over.
 MIN_SHOTS = 4
-#: The maximum is where |d(−log L)/dβ| <= this × the total weight (the shots), within
-#: this many trust-region steps (a convex problem takes fewer than 20).
-GRADIENT_TOLERANCE, MAX_ITERATIONS = 1e-8, 200
+#: The largest weight a row takes (a billion shots): beyond it the sums that the fit and
+#: its intervals work with lose their meaning, and the bootstrap's counts their type.
+MAX_WEIGHT = 1e9
 
 
 @attrs.frozen
@@ -141,23 +145,41 @@ def check_arrays(
         raise ParameterError("impact_speed", "impact speeds must be finite and > 0 m/s")
     if not np.isin(y, (0, 1)).all():
         raise ParameterError("perforated", "perforated must be true/false (1/0) per shot")
-    if not np.all(np.isfinite(w) & (w >= 0)):
-        raise ParameterError("weight", "weights must be finite and >= 0")
+    if not np.all((w >= 0) & (w <= MAX_WEIGHT)):  # NaN fails too
+        raise ParameterError(
+            "weight", f"weights must be in [0, {MAX_WEIGHT:g}] (the shots a row stands for)"
+        )
     return v, y.astype(bool), w
 
 
+def rounds(weight: np.ndarray) -> int | float:
+    """How many shots the weights stand for (their sum): a whole number when they are."""
+    total = float(weight.sum())
+    return int(total) if total.is_integer() else total
+
+
+def shown(count: int | float) -> str:
+    """A count of shots for people: whole numbers in full, others to 6 digits."""
+    return str(count) if isinstance(count, int) else f"{count:.6g}"
+
+
 def check_shots(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray, label: str) -> None:
-    """Refuse shots no fit can take: too few, one outcome, or no overlap of the outcomes."""
+    """Refuse shots no fit can take: too few, one outcome, or outcomes separated by a speed
+    (the likelihood then has no maximum). Shots are counted as rounds: a row of weight w
+    is w shots."""
     used = weight > 0
-    count, go = int(used.sum()), int((used & perforated).sum())
-    if count < MIN_SHOTS or go == 0 or go == count:
+    count, go = rounds(weight[used]), rounds(weight[used & perforated])
+    no_go = rounds(weight[used & ~perforated])
+    rows, go_rows = int(used.sum()), int((used & perforated).sum())
+    if count < MIN_SHOTS or go_rows == 0 or go_rows == rows:
+        in_rows = f" (in {rows} rows)" if rows != count else ""
         raise V50Error(
-            f"{label}: too few shots for a V50 fit: {count} shots, {go} perforations and "
-            f"{count - go} non-perforations; a fit needs at least {MIN_SHOTS} shots with "
-            "both outcomes"
+            f"{label}: too few shots for a V50 fit: {shown(count)} shots{in_rows}, "
+            f"{shown(go)} perforations and {shown(no_go)} non-perforations; a fit needs at "
+            f"least {MIN_SHOTS} shots with both outcomes"
         )
-    highest_no_go = float(speed[used & ~perforated].max())
-    lowest_go = float(speed[used & perforated].min())
+    go_speeds, no_go_speeds = speed[used & perforated], speed[used & ~perforated]
+    highest_no_go, lowest_go = float(no_go_speeds.max()), float(go_speeds.min())
     if highest_no_go <= lowest_go:
         raise V50Error(
             f"{label}: no zone of mixed results: every perforation (the slowest at "
@@ -165,6 +187,14 @@ def check_shots(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray, l
             f"at {highest_no_go:.6g} m/s), so the likelihood has no maximum (sigma -> 0); fire "
             f"more shots between {highest_no_go:.6g} and {lowest_go:.6g} m/s, or use the "
             "MIL-STD-662F estimate (--method mil-std-662f)"
+        )
+    highest_go, lowest_no_go = float(go_speeds.max()), float(no_go_speeds.min())
+    if highest_go <= lowest_no_go:
+        raise V50Error(
+            f"{label}: perforation does not become more likely with speed in these shots: "
+            f"every perforation (the fastest at {highest_go:.6g} m/s) is at most as fast as "
+            f"every non-perforation (the slowest at {lowest_no_go:.6g} m/s): they show no "
+            "ballistic limit"
         )
 
 
@@ -177,34 +207,6 @@ def prepared(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray) -> G
     spread = float(np.sqrt(np.average((v - centre) ** 2, weights=w)))
     sign = np.where(perforated[used], 1.0, -1.0)
     return GoNoGo((v - centre) / spread, sign, w, centre, spread)
-
-
-def maximum(shots: GoNoGo, link: Link, label: str) -> Estimate:
-    """The maximum of the likelihood, by scipy's trust-region solver on the convex
-    −log L(β0, β1), z = β0 + β1 x; V50Error if it does not converge."""
-    design = np.column_stack([np.ones_like(shots.x), shots.x])
-
-    def value(beta: np.ndarray) -> float:
-        return shots.negative_log_likelihood(design @ beta, link)
-
-    def gradient(beta: np.ndarray) -> np.ndarray:
-        return design.T @ shots.eta_derivatives(design @ beta, link)[0]
-
-    def hessian(beta: np.ndarray) -> np.ndarray:
-        curvature = shots.eta_derivatives(design @ beta, link)[1]
-        return (design.T * curvature) @ design
-
-    tolerance = GRADIENT_TOLERANCE * float(shots.weight.sum())
-    found = optimize.minimize(
-        value, np.array([0.0, 1.0]), jac=gradient, hess=hessian, method="trust-exact",
-        options={"gtol": tolerance, "maxiter": MAX_ITERATIONS},
-    )  # fmt: skip
-    # Converged is a gradient at zero to rounding, whatever the solver's status says (it
-    # may stop one step late, unable to improve on a value already exact to rounding).
-    if not (np.all(np.isfinite(found.x)) and np.abs(gradient(found.x)).max() <= tolerance):
-        raise V50Error(f"{label}: the {link.name} fit did not converge: {found.message}")
-    intercept, slope = (float(b) for b in found.x)
-    return Estimate(intercept, slope, float(found.fun), int(found.nit))
 
 
 def increasing(best: Estimate, label: str) -> Estimate:
