@@ -149,3 +149,22 @@ try:
     settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 except ImportError:  # hypothesis is a test extra
     pass
+
+
+@pytest.fixture(scope="session")
+def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The output directory of ``plateimpact reproduce --quick --dpi 50``, made once per
+    session: the archive ``report.h5`` (every study, variant and setting kind of the
+    report, the stored outcome maps) and the figures and P* table. Read it only: copy
+    it (``shutil.copytree``) to change it."""
+    import contextlib
+    import io
+
+    from plateimpact.cli import main
+
+    out = tmp_path_factory.mktemp("quick") / "report"
+    printed, errors = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(errors):
+        code = main(["reproduce", "--quick", "--out", str(out), "--dpi", "50"])
+    assert code == 0, errors.getvalue()
+    return out

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -275,4 +276,72 @@ def test_malformed_plate_files_give_one_line_errors(fields, garbage):
             path = Path(directory) / f"plate{n}.json"
             path.write_bytes(content)
             argv = ["run", "--plate-file", str(path), "--speed", "500", "--obliquity", "30"]
+            assert_clean(*run_cli(argv))
+
+
+#: What someone else's JSON may hold where a number or a name belongs.
+JSON_LITERALS = st.sampled_from(
+    ["[" * 40 + "]" * 40, "[" * 5000 + "]" * 5000, "1" * 401, "1" * 19, "1e400", "-1e400",
+     "true", "null", '"x"', '"500"', "[]", "{}", "NaN", "Infinity", "-0", "0", "1e-400",
+     '{"a": 1, "a": 2}', '"\\u202e\\n\\u001b[2J"', '"' + "x" * 10_000 + '"']
+)  # fmt: skip
+#: A key and its scalar value in compact JSON.
+SCALAR = re.compile(r'"(\w+)": (-?[\d.eE+-]+|true|false|null|Infinity|"[^"]*")')
+
+
+def _edited(text: str, edits: list[tuple[int, str, str]]) -> str:
+    """``text`` with each edit applied at the scalar it picks (by index, modulo their
+    number): its value replaced, its key given again before it, or its value nested."""
+    for index, how, literal in edits:
+        found = list(SCALAR.finditer(text))
+        if not found:
+            break
+        match = found[index % len(found)]
+        key, value = match.group(1), match.group(2)
+        start, end = match.span()
+        if how == "replace":
+            pair = f'"{key}": {literal}'
+        elif how == "duplicate":
+            pair = f'"{key}": {literal}, "{key}": {value}'
+        else:  # nest
+            pair = f'"{key}": {"[" * 40}{value}{"]" * 40}'
+        text = text[:start] + pair + text[end:]
+    return text
+
+
+@pytest.fixture(scope="module")
+def run_record() -> str:
+    """A ``run --json`` output, for the JSON fuzz to damage."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        code = cli(["run", "--preset", "2024-T3/3.18", "--speed", "500", "--obliquity", "45",
+                    "--json"])  # fmt: skip
+    assert code == 0
+    return out.getvalue()
+
+
+@given(
+    edits=st.lists(
+        st.tuples(
+            st.integers(0, 1000), st.sampled_from(["replace", "duplicate", "nest"]), JSON_LITERALS
+        ),
+        min_size=1,
+        max_size=3,
+    ),
+    wrap=st.sampled_from([0, 0, 1, 40, 100_000]),
+)
+def test_nested_duplicated_and_huge_json_gives_one_line_errors(run_record, edits, wrap):
+    import json  # noqa: PLC0415
+
+    record = json.loads(run_record)["inputs"]
+    plate = pi.storage.plate_file.plate_to_dict(presets.plate("2024-T3/3.18"))
+    with tempfile.TemporaryDirectory() as directory:
+        for name, value in (("run.json", record), ("plate.json", plate)):
+            text = _edited(json.dumps(value), edits)
+            path = Path(directory) / name
+            path.write_text("[" * wrap + text + "]" * wrap)
+            if name == "run.json":
+                argv = ["run", "--inputs", str(path)]
+            else:
+                argv = ["run", "--plate-file", str(path), "--speed", "500", "--obliquity", "30"]
             assert_clean(*run_cli(argv))

@@ -20,8 +20,9 @@ ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "framework" / "plateimpact"
 LAYERS = {
     "physics": {
-        "units", "errors", "parameters", "bodies", "scene", "batch", "geometry", "plugin",
-        "resistance", "failure", "binding", "model", "results", "ragged", "crater", "presets",
+        "units", "errors", "untrusted", "parameters", "bodies", "scene", "batch", "geometry",
+        "plugin", "resistance", "failure", "binding", "model", "results", "ragged", "crater",
+        "presets",
     },
     "running": {
         "dense", "dynamics", "integrator", "control", "events", "recorder", "driver",

@@ -1,5 +1,5 @@
 """JSON from someone else within bounds, and file text made inert for a terminal
-(storage.untrusted)."""
+(plateimpact.untrusted)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import math
 import pytest
 
 from plateimpact.errors import PlateFileError
-from plateimpact.storage.untrusted import MAX_DEPTH, load_json, printable
+from plateimpact.untrusted import MAX_DEPTH, load_json, printable
 
 
 def test_plain_json_reads_as_json_does():

@@ -11,7 +11,6 @@ say how users write them (``mm``, ``deg``).
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from typing import Any
@@ -20,6 +19,7 @@ import attrs
 import numpy as np
 
 from .errors import ParameterError
+from .untrusted import load_json
 
 #: SI units that are written differently in file keys and JSON names (``a_N_m2``).
 _KEY_UNITS = {"1": "", "N/m^2": "N_m2", "kg/m^3": "kg_m3", "m/s": "m_s"}
@@ -310,17 +310,21 @@ def declared_settings(cls: type) -> dict[str, Parameter]:
         if declared is None:
             default = NO_DEFAULT if field.default is attrs.NOTHING else field.default
             declared = Parameter(
-                field.name, f"setting {field.name}", default=default, convert=_json_literal
+                field.name, f"setting {field.name}", default=default, convert=json_literal
             )
         settings[field.name] = declared
     return settings
 
 
-def _json_literal(value: Any) -> Any:
-    """An undeclared setting from the command line: a JSON literal, else the text."""
-    if isinstance(value, str):
-        try:
-            return json.loads(value)
-        except ValueError:
-            return value
-    return value
+def json_literal(value: Any) -> Any:
+    """An undeclared setting given as text: a JSON literal, else the text itself
+    (``RK23``). JSON beyond untrusted.load_json's bounds (nesting, integer digits, a key
+    given twice, NaN) is a one-line ParameterError, never a traceback or a key that
+    silently wins."""
+    if not isinstance(value, str):
+        return value
+    return load_json(value, "setting", _setting_error, text_if_not_json=True)
+
+
+def _setting_error(message: str) -> ParameterError:
+    return ParameterError("setting", message)

@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 import os
 import textwrap
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -337,18 +337,21 @@ def plot_calibration(
     return ax
 
 
-def save(fig: Figure, path: str | os.PathLike[str], flag: str = "figure", dpi: float = DPI) -> None:
-    """Save a figure, its format from the file's extension (PNG, SVG, PDF, ...), all of it
-    or nothing: written beside the target and renamed over it (storage.output). ``dpi``
-    [dots per inch] sets a raster's pixels. A figure with a layout engine keeps its size
-    (a PNG is ``dpi`` × its inches); one without is cropped to what is drawn."""
+def figure_writer(
+    fig: Figure, path: str | os.PathLike[str], dpi: float = DPI
+) -> Callable[[IO[bytes]], object]:
+    """What writes ``fig`` to a binary handle in the format of ``path``'s extension (PNG,
+    SVG, PDF, ...) at ``dpi`` [dots per inch] for a raster: a figure with a layout
+    engine keeps its size (a PNG is ``dpi`` × its inches); one without is cropped to
+    what is drawn. For storage.output's writers (:func:`save`, a set of outputs)."""
     if not DPI_RANGE[0] <= dpi <= DPI_RANGE[1]:  # also refuses NaN
         raise ValueError(f"dpi must be from {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g}, got {dpi}")
     suffix = Path(path).suffix.lower().lstrip(".")
     crop = None if fig.get_layout_engine() else "tight"
-    write_output(
-        path,
-        flag,
-        lambda handle: fig.savefig(handle, format=suffix, dpi=dpi, bbox_inches=crop),
-        kind="figure",
-    )
+    return lambda handle: fig.savefig(handle, format=suffix, dpi=dpi, bbox_inches=crop)
+
+
+def save(fig: Figure, path: str | os.PathLike[str], flag: str = "figure", dpi: float = DPI) -> None:
+    """Save a figure (:func:`figure_writer`), all of it or nothing: written beside the
+    target and renamed over it (storage.output)."""
+    write_output(path, flag, figure_writer(fig, path, dpi), kind="figure")

@@ -13,6 +13,7 @@ from .errors import ParameterError
 from .model import REST_SPEED_FRACTION
 from .registry import PluginRegistry
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from .untrusted import load_json
 
 
 def _json_value(value: object) -> object:
@@ -51,6 +52,14 @@ def check_name(instance: object, attribute: attrs.Attribute, value: object) -> N
         )
 
 
+def check_plugin_name(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    """A plug-in name: a string (which plug-in it names is checked when it is run)."""
+    if not isinstance(value, str):
+        raise ParameterError(
+            attribute.name, f"{attribute.name} must be a plug-in name, got {value!r:.60}"
+        )
+
+
 @attrs.frozen
 class Variant:
     """One model variant of a study: plug-in names and their settings [SI].
@@ -60,9 +69,9 @@ class Variant:
     """
 
     name: str = attrs.field(validator=check_name)
-    resistance: str = DEFAULT_RESISTANCE
-    failure: str = DEFAULT_FAILURE
-    integrator: str = DEFAULT_INTEGRATOR
+    resistance: str = attrs.field(default=DEFAULT_RESISTANCE, validator=check_plugin_name)
+    failure: str = attrs.field(default=DEFAULT_FAILURE, validator=check_plugin_name)
+    integrator: str = attrs.field(default=DEFAULT_INTEGRATOR, validator=check_plugin_name)
     resistance_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     failure_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     integrator_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
@@ -86,4 +95,21 @@ class Variant:
 
     @classmethod
     def from_json(cls, text: str) -> Variant:
-        return cls(**json.loads(text))
+        """The variant of :meth:`to_json`'s text (an archive's record, which may come from
+        anyone): malformed or too deeply nested JSON, a key given twice, an unknown key
+        or a value of the wrong type is a one-line ParameterError."""
+        data = load_json(text, "variant", _variant_error)
+        if not isinstance(data, dict):
+            raise ParameterError("variant", f"variant: expected a JSON object, got {data!r:.60}")
+        known = {field.name for field in attrs.fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ParameterError(
+                "variant",
+                f"variant: unknown key {unknown[0]!r:.60} (known: {', '.join(sorted(known))})",
+            )
+        return cls(**data)
+
+
+def _variant_error(message: str) -> ParameterError:
+    return ParameterError("variant", message)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 from collections.abc import Sequence
@@ -18,6 +19,11 @@ from .separation import PlaneSeparation
 
 #: The smallest P* of a row [mm]: the plate constant's.
 SMALLEST_PSTAR_MM = CRITICAL_PENETRATION.range.low / CRITICAL_PENETRATION.scale
+
+#: Rows a table takes at most: a row per obliquity measured, a few in practice; and the
+#: largest table file read [bytes] (1000 rows of five long numbers).
+MAX_ROWS = 1000
+MAX_BYTES = 1 << 20
 
 TABLE_COLUMNS = (
     "obliquity_deg",
@@ -60,6 +66,8 @@ class PstarTable:
         start [m/s], transition end [m/s]), sorted by obliquity."""
         if len(rows) == 0:
             raise _fail("needs at least one row")
+        if len(rows) > MAX_ROWS:
+            raise _fail(f"{len(rows):,} rows; a table takes at most {MAX_ROWS:,}")
         values = []
         for number, row in enumerate(rows, start=1):
             if len(row) != len(TABLE_COLUMNS):
@@ -67,7 +75,8 @@ class PstarTable:
             try:
                 values.append([float(x) for x in row])
             except (TypeError, ValueError):
-                raise _fail(f"row {number} has a value that is not a number: {row!r}") from None
+                shown = f"{row!r:.80}"  # repr: control characters escaped
+                raise _fail(f"row {number} has a value that is not a number: {shown}") from None
         data = np.array(values)
         for number, (obliquity, ricochet, perforation, start, end) in enumerate(data, start=1):
             if not 0.0 <= obliquity < 90.0:
@@ -100,21 +109,25 @@ class PstarTable:
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str]) -> PstarTable:
         """A table from a CSV file with the header of :data:`TABLE_COLUMNS` (any order)."""
+        where = f"{os.fspath(path)!r:.200}"  # repr: control characters escaped
         try:
-            with open(path, encoding="utf-8-sig", newline="") as handle:  # a BOM is allowed
-                reader = csv.DictReader(handle)
-                names = [name.strip() for name in reader.fieldnames or ()]
-                missing = set(TABLE_COLUMNS) - set(names)
-                if missing:
-                    raise _fail(f"{path}: missing columns {', '.join(sorted(missing))}")
-                reader.fieldnames = names
-                rows = [[line[c] for c in TABLE_COLUMNS] for line in reader]
+            with open(path, "rb") as handle:  # never more than a table can hold
+                data = handle.read(MAX_BYTES + 1)
+            if len(data) > MAX_BYTES:
+                raise _fail(f"{where}: more than {MAX_BYTES:,} bytes; a table holds at most that")
+            reader = csv.DictReader(io.StringIO(data.decode("utf-8-sig"), newline=""))
+            names = [name.strip() for name in reader.fieldnames or ()]
+            missing = set(TABLE_COLUMNS) - set(names)
+            if missing:
+                raise _fail(f"{where}: missing columns {', '.join(sorted(missing))}")
+            reader.fieldnames = names
+            rows = [[line[c] for c in TABLE_COLUMNS] for line in reader]
         except OSError as exc:
-            raise _fail(f"cannot read {path}: {exc.strerror}") from None
+            raise _fail(f"cannot read {where}: {exc.strerror}") from None
         except UnicodeDecodeError:
-            raise _fail(f"cannot read {path}: not UTF-8 text") from None
+            raise _fail(f"cannot read {where}: not UTF-8 text") from None
         except csv.Error as exc:
-            raise _fail(f"{path}: not a CSV table ({exc})") from None
+            raise _fail(f"{where}: not a CSV table ({str(exc)!r:.80})") from None
         return cls.from_rows(rows)
 
     @classmethod
@@ -123,8 +136,9 @@ class PstarTable:
         return cls.from_rows([(0.0, pstar * 1e3, pstar * 1e3, 0.0, 0.0)])
 
     def as_setting(self) -> list[list[float]]:
-        """The table as a JSON value (its rows), for study variants and archives."""
-        return [list(row) for row in self.rows()]
+        """The table as a JSON value (its rows, plain floats), for study variants and
+        archives."""
+        return [[float(x) for x in row] for row in self.rows()]
 
     def rows(self) -> list[tuple[float, ...]]:
         """The table in user units, as :meth:`from_rows` takes it."""
@@ -181,6 +195,20 @@ def _to_table(value: object) -> PstarTable:
     )
 
 
+def _table_json(value: object) -> object:
+    """The table as a JSON value: its rows. What an archive gives back is already rows
+    (plain lists): checked as rows and kept as they are, so a setting read back describes
+    itself exactly as the table did (converting them through SI again could move the
+    last digit). A CSV path stays the path it is."""
+    if isinstance(value, PstarTable):
+        return value.as_setting()
+    if isinstance(value, str | os.PathLike):
+        return os.fspath(value)
+    _to_table(value)  # a ParameterError for what no table is made of
+    rows: Sequence[Sequence[float]] = value if isinstance(value, Sequence) else ()
+    return [[float(x) for x in row] for row in rows]
+
+
 PSTAR_TABLE = Parameter(
     "table",
     "P* by impact obliquity and speed: a PstarTable, its rows, or a CSV file with columns "
@@ -189,7 +217,7 @@ PSTAR_TABLE = Parameter(
     default=None,
     flag="--pstar-table",
     convert=lambda value: _to_table(SAE1010_TABLE if value is None else value),
-    to_json=lambda table: [list(row) for row in table.rows()],
+    to_json=_table_json,
 )
 
 

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from ..errors import ParameterError, PlateImpactError, PluginError
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..storage.provenance import versions
+from ..untrusted import printable
 from . import (
     archive_commands,
     calibrate,
@@ -27,7 +28,14 @@ from . import (
     v50_command,
     validate,
 )
-from .common import Parser, UsageError
+from .common import (
+    Parser,
+    StdoutError,
+    UsageError,
+    discard_stdout,
+    flush_stdout,
+    stdout_closed,
+)
 from .options import flag_of
 from .reporting import one_line_warnings, report_internal_error
 from .sweep_csv import SWEEP_COLUMNS
@@ -88,24 +96,35 @@ def _flag_taken(registry: PluginRegistry, flag: str) -> str:
     )
 
 
+def _error(message: object) -> int:
+    """Print the one-line error (any character a terminal would act on escaped, so that
+    a message quoting a file is still one inert line); the exit code, 2."""
+    print(f"plateimpact: error: {printable(message)}", file=sys.stderr)
+    return 2
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``plateimpact`` command; returns the exit code."""
     arguments = list(sys.argv[1:] if argv is None else argv)
+    if stdout_closed():  # before any work: what it would print could not be seen
+        return _error("standard output is closed; redirect it (e.g. > /dev/null)")
     args = argparse.Namespace()
     with warnings.catch_warnings():  # restores the caller's warning display on return
         warnings.showwarning = one_line_warnings(warnings.showwarning)
         try:
             args = build_parser().parse_args(arguments)
             args.command_function(args)
+            flush_stdout()  # what is still buffered: its failure is the command's
         except ParameterError as exc:
             flag = flag_of(args, exc.parameter)
             prefix = f"{flag}: " if flag else ""
-            print(f"plateimpact: error: {prefix}{exc}", file=sys.stderr)
-            return 2
+            return _error(f"{prefix}{exc}")
         except PlateImpactError as exc:
-            print(f"plateimpact: error: {exc}", file=sys.stderr)
-            return 2
+            if isinstance(exc, StdoutError):
+                discard_stdout()
+            return _error(exc)
         except BrokenPipeError:  # e.g. piped into head
+            discard_stdout()
             sys.stderr.close()
             return 0
         except KeyboardInterrupt:

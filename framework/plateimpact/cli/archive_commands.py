@@ -3,14 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import errno
 import math
 import os
 from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from ..discovery import (
     BrokenPackage,
@@ -21,21 +18,29 @@ from ..discovery import (
 )
 from ..errors import ArchiveError, PluginError
 from ..progress import progress_bar
-from ..results import BatchResult
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths
-from ..storage.untrusted import printable
 from ..study import Study, StudyResults
-from .common import UsageError, add_dpi_option, check_directory
-from .describe import run_lines, scene_line
+from ..untrusted import printable
+from .common import UsageError, add_dpi_option, check_directory, output_directory, say
+from .describe import run_description
 from .run_comparison import print_comparison
 from .stored_limits import compare_stored, kinds, show_stored
 
 
 def add_parsers(sub: Any) -> None:
     p = sub.add_parser("reproduce", help="run the report's figure families into one archive")
-    p.add_argument("--out", default="report", help="output directory, created (default: report)")
+    p.add_argument(
+        "--out",
+        help="output directory, created (default: report, with --quick report-quick)",
+    )
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="a smoke test of the whole job in a few seconds: every study, variant, "
+        "stored map and experiment tool, through the same code, on a few scenes each",
+    )
     rerun = p.add_mutually_exclusive_group()
     rerun.add_argument(
         "--resume",
@@ -153,25 +158,32 @@ def study_collection(name: str) -> Any:
         ) from None
 
 
+#: Bytes of path kept for what reproduce writes inside --out: the archive's data files
+#: (report.h5.d/STUDY.VARIANT.HASH.nc), the figures and their temporary names.
+REPRODUCE_SPARE = 128
+
+
 def reproduce_command(args: argparse.Namespace) -> None:
     from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
 
     reproduce = study_collection("report")
+    if args.out is None:  # a quick archive holds other scenes: never the full one's place
+        args.out = "report-quick" if args.quick else "report"
     out = Path(args.out)
     if not str(args.out).strip():
         raise UsageError("--out: give a directory name")
     _check_out_names(out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out: {args.out!r} exists and is not a directory")
-    if not out.parent.resolve().is_dir():
-        raise UsageError(f"--out: directory {str(out.parent)!r} does not exist")
     if args.tag is not None and not _printable_tag(args.tag):
         raise UsageError(f"--as: give a printable tag without '/' or spaces, got {args.tag!r}")
-    _make_out(out)
+    output_directory(args.out, "--out", REPRODUCE_SPARE)  # checked and created, or one line
+    _check_out_archive(out)
     try:
+        # quick only when asked: a collection of an older signature still runs in full
+        quick = {"quick": True} if args.quick else {}
         archive, figures = reproduce(
-            out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format
-        )
+            out, None, args.resume, args.overwrite, args.tag, dpi=args.dpi, suffix=args.format,
+            **quick,
+        )  # fmt: skip
     except StaleRunError as exc:  # neither kept nor replaced unasked: say how to proceed
         raise UsageError(
             f"{exc.what}; --overwrite replaces it, --as TAG stores the new runs as "
@@ -182,9 +194,9 @@ def reproduce_command(args: argparse.Namespace) -> None:
             f"{str(exc).split(':', 1)[0]}: --resume keeps it (runs only what is missing), "
             "--overwrite replaces it, --as TAG stores the new runs as VARIANT@TAG"
         ) from None
-    print(f"archive: {archive}")
+    say(f"archive: {archive}")
     for figure in figures:
-        print(f"figure:  {figure}")
+        say(f"figure:  {figure}")
 
 
 #: The archive ``reproduce`` writes in its output directory (plateimpact_studies.reproduce).
@@ -206,14 +218,9 @@ def _check_out_names(out: Path) -> None:
         raise UsageError(str(exc)) from None
 
 
-def _make_out(out: Path) -> None:
-    """Make the output directory and check that its archive can be written (one line
-    naming --out otherwise: a read-only filesystem, a damaged archive, a shipped lock)."""
-    try:
-        out.mkdir(exist_ok=True)
-    except OSError as exc:
-        reason = "a read-only filesystem" if exc.errno == errno.EROFS else exc.strerror
-        raise UsageError(f"--out: cannot make the directory {out}: {reason}") from None
+def _check_out_archive(out: Path) -> None:
+    """Check that the archive in the output directory can be written (one line naming
+    --out otherwise: a damaged archive, a shipped lock)."""
     try:
         Archive(out / REPORT_ARCHIVE).check_writable()
     except ArchiveError as exc:
@@ -235,34 +242,9 @@ def _study_results(archive: Archive, runs: list[str]) -> StudyResults:
 
 
 def show_command(args: argparse.Namespace) -> None:
-    from ..storage.code_provenance import summary as code_lines  # noqa: PLC0415
-
     archive = Archive(args.archive)
     for name in archive.runs():
-        meta: dict[str, Any] = archive.metadata(name)
-        result: BatchResult = archive.results(name)
-        counts = np.bincount(result.outcome, minlength=4)[1:]
-        print(f"{name}")
-        for line in run_lines(meta):
-            print(line)
-        for line in code_lines(meta.get("plugins")):  # each plug-in's origin and source hash
-            print(f"  {line}")
-        study = archive.study(name.split("/", 1)[0])
-        print(scene_line(study.scenes, study.plate_labels))
-        print(
-            f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
-            f"{counts[2]} perforation; wall {meta['wall_time_s']:.2f} s"
-        )
-        kept = [
-            what
-            for what, data in (("trajectories", result.trajectory), ("craters", result.craters))
-            if data is not None
-        ]
-        if kept:
-            print(f"  with {' and '.join(kept)}")
-        print(f"  run {meta['start_time']} on {meta['host']}")
-        data = archive.data_file(name)  # format 2: the run's own netCDF file
-        print(f"  data {data}" if data is not None else "  data in the archive (format 1)")
+        say("\n".join(run_description(archive, name)))
     show_stored(archive)
 
 
@@ -291,7 +273,7 @@ def compare_command(args: argparse.Namespace) -> None:
 
         plotting.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
         if not args.json:
-            print(f"figure: {args.png}")
+            say(f"figure: {args.png}")
 
 
 def plot_command(args: argparse.Namespace) -> None:
@@ -315,4 +297,4 @@ def plot_command(args: argparse.Namespace) -> None:
         stages.update()
         plotting.save(figure, args.out, "--out", dpi=args.dpi)
         stages.update()
-    print(f"figure: {args.out}")
+    say(f"figure: {args.out}")

@@ -20,9 +20,16 @@ from ..simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions
 from ..storage.shots import Shots
+from ..storage.together import write_together
 from ..units import g, mm
 from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
-from .common import add_dpi_option, check_directory, save_figure_atomically, write_atomically
+from .common import (
+    add_dpi_option,
+    check_directory,
+    figure_output,
+    say,
+    text_output,
+)
 from .options import add_body_options, add_model_options, bodies, model_choice
 
 if TYPE_CHECKING:
@@ -111,14 +118,17 @@ def calibrate_command(args: argparse.Namespace) -> None:
     chosen = report.newton if args.method == "newton" else report.direct
     summary = _summary(args, report, chosen)
     summary["model"] = simulation.describe()
+    outputs = []  # the plate file and the figure of its fit land together
     if args.out is not None:
         provenance = _provenance(args, report, chosen, sphere)
         extra = {"calibration": {**provenance, "model": summary["model"]}}
-        write_atomically(args.out, plate_file_text(chosen.plate, extra), "--out")
+        outputs.append(text_output(args.out, plate_file_text(chosen.plate, extra), "--out"))
     if args.png is not None:
-        save_figure_atomically(_figure(report, sphere, simulation), args.png, dpi=args.dpi)
+        figure = _figure(report, sphere, simulation)
+        outputs.append(figure_output(figure, args.png, "--png", args.dpi))
+    write_together(outputs)
     if args.json:
-        print(json.dumps(summary))
+        say(json.dumps(summary))
     else:
         _print_text(args, report, chosen)
 
@@ -187,16 +197,16 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
     normal = report.shots.normal_incidence()
     ignored = len(report.shots) - len(normal)
     dri = report.dri
-    print(
+    say(
         f"shots: {args.shots}: {len(normal)} at normal incidence, "
         f"{int(normal.perforated.sum())} perforating"
         + (f" ({ignored} oblique shots not used)" if ignored else "")
     )
-    print(
+    say(
         f"DRI fit (eqs 40-41): R = {dri.R:.5g} ± {dri.R_stderr:.2g}, "
         f"V0 = {dri.V0:.5g} ± {dri.V0_stderr:.2g} m/s, rms residual {dri.rms_residual:.3g} m/s"
     )
-    print(
+    say(
         f"{'':22s}{'a [N/m^2]':>22s}{'b [kg/m^3]':>20s}{'steps':>7s}"
         f"{'model R':>10s}{'model V0':>10s}{'rms [m/s]':>10s}"
     )
@@ -204,23 +214,23 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
         ("newton (eqs 44-49)", report.newton),
         ("direct least squares", report.direct),
     ):
-        print(
+        say(
             f"{name:22s}{f'{fit.a:.5g} ± {fit.a_stderr:.2g}':>22s}"
             f"{f'{fit.b:.5g} ± {fit.b_stderr:.2g}':>20s}{fit.iterations:7d}"
             f"{fit.model_fit.R:10.5g}{fit.model_fit.V0:10.5g}{fit.rms_residual:10.3g}"
         )
     newton, direct = report.newton, report.direct
-    print(
+    say(
         f"direct - newton: a {100 * (direct.a / newton.a - 1):+.3g} %, "
         f"b {100 * (direct.b / newton.b - 1):+.3g} % "
         f"({abs(direct.a - newton.a) / newton.a_stderr:.2g} and "
         f"{abs(direct.b - newton.b) / newton.b_stderr:.2g} standard errors of newton)"
     )
-    print(f"plate ({chosen.method}): a = {chosen.a:.6g} N/m^2, b = {chosen.b:.6g} kg/m^3")
+    say(f"plate ({chosen.method}): a = {chosen.a:.6g} N/m^2, b = {chosen.b:.6g} kg/m^3")
     if args.out is not None:
-        print(f"plate file: {args.out}")
+        say(f"plate file: {args.out}")
     if args.png is not None:
-        print(f"figure: {args.png}")
+        say(f"figure: {args.png}")
 
 
 def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:

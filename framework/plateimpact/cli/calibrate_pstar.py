@@ -32,7 +32,7 @@ from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions
 from ..storage.shots import Shots
 from ..units import g, mm
-from .common import UsageError, check_directory, write_atomically
+from .common import UsageError, check_directory, say, write_atomically
 from .options import bodies, model_choice, typed
 
 #: The options only --fit pstar reads, with their defaults (a typed one is refused with
@@ -151,13 +151,13 @@ def pstar_command(args: argparse.Namespace) -> None:
         summary = _table_summary(args, table, simulation, finder, sphere)
         if args.out is not None:
             write_atomically(args.out, table.csv_text(), "--out")
-        print(json.dumps(summary) if args.json else _table_text(args, table))
+        say(json.dumps(summary) if args.json else _table_text(args, table))
         return
     summary = _fit_summary(args, fit, simulation, finder, sphere)
     if args.out is not None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
         write_atomically(args.out, plate_file_text(fit.plate, extra), "--out")
-    print(json.dumps(summary) if args.json else _fit_text(args, fit))
+    say(json.dumps(summary) if args.json else _fit_text(args, fit))
 
 
 def _finite(x: float) -> float | None:

@@ -1,17 +1,34 @@
-"""What every command shares: the one-line error, output files written atomically."""
+"""What every command shares: the one-line error, output files written atomically, and
+the one writer of standard output (:func:`say`, :func:`write_stdout`): a full or closed
+standard output is one line and exit code 2, never a traceback or Python's "Exception
+ignored" at exit."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import io
 import math
+import os
 import sys
 from collections.abc import Iterable, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import PlateImpactError
-from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, OutputError, check_output, write_text
+from ..storage.output import (
+    FIGURE_DPI,
+    FIGURE_DPI_RANGE,
+    OutputError,
+    check_output,
+    check_path,
+    shown_path,
+    unwritable,
+    write_text,
+)
+from ..storage.together import Output
+from ..untrusted import printable
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -29,7 +46,15 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
-        self.exit(2, f"plateimpact: error: {message}\n")
+        self.exit(2, f"plateimpact: error: {printable(message)}\n")
+
+    def _print_message(self, message: str, file: Any = None) -> None:
+        # --help and --version go through the one writer: argparse's own swallows a
+        # failed write (and Python reports it at exit)
+        if message and (file is None or file is sys.stdout):
+            write_stdout(message)
+        else:
+            super()._print_message(message, file)
 
 
 def check_directory(path: str | None, flag: str, kind: str = "csv") -> None:
@@ -38,6 +63,36 @@ def check_directory(path: str | None, flag: str, kind: str = "csv") -> None:
     regular file, read-only, a figure format matplotlib cannot write)."""
     if path is not None:
         check_output(path, flag, kind)
+
+
+def output_directory(path: str, flag: str, spare: int = 0) -> Path:
+    """The directory ``path``, created if need be (its parent must exist), after refusing
+    with one line naming ``flag`` what could not hold the outputs: an empty name, a path
+    too long (``spare`` bytes kept for the names of the files inside), a name too long,
+    a file where a directory must be, a missing parent, a directory that cannot be
+    written (read-only filesystem included). Call it before any work."""
+    if not path.strip():
+        raise OutputError(f"{flag}: give a directory name, got {path!r}")
+    if "\0" in path:
+        raise OutputError(f"{flag}: a directory name cannot hold a NUL character")
+    real = Path(os.path.realpath(path))
+    check_path(real, flag, spare)
+    if real.exists():
+        if not real.is_dir():
+            raise OutputError(f"{flag}: {shown_path(path)} exists and is not a directory")
+        where = real
+    else:
+        where = real.parent
+        if not where.is_dir():
+            raise OutputError(f"{flag}: directory {shown_path(str(where))} does not exist")
+    if not os.access(where, os.W_OK | os.X_OK):
+        raise OutputError(f"{flag}: directory {shown_path(str(where))} is {unwritable(where)}")
+    try:
+        real.mkdir(exist_ok=True)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise OutputError(f"{flag}: cannot create {shown_path(path)}: {reason}") from None
+    return real
 
 
 def dots_per_inch(text: str) -> float:
@@ -70,6 +125,20 @@ def save_figure_atomically(
     plotting.save(fig, path, flag, dpi=plotting.DPI if dpi is None else dpi)
 
 
+def text_output(path: str, text: str, flag: str, kind: str = "csv") -> Output:
+    """``text`` (UTF-8) to ``path``: one file of a set written together."""
+    return Output(path, flag, lambda handle: handle.write(text.encode()), kind)
+
+
+def figure_output(fig: Figure, path: str, flag: str, dpi: float | None = None) -> Output:
+    """A figure to ``path`` (format from its extension; ``dpi`` [dots per inch] for a
+    raster, default plotting's): one file of a set written together."""
+    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+
+    writer = plotting.figure_writer(fig, path, plotting.DPI if dpi is None else dpi)
+    return Output(path, flag, writer, "figure")
+
+
 def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     """``--dpi N``: the resolution of raster figures, checked before any work."""
     parser.add_argument(
@@ -81,15 +150,74 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
+class StdoutError(OutputError):
+    """Standard output cannot take what a command prints: a full device, a closed one."""
+
+
+def stdout_closed() -> bool:
+    """Whether the command was started with standard output closed (``>&-``): Python then
+    has no ``sys.stdout``, and the next file opened would take its descriptor."""
+    if sys.stdout is None:
+        return True
+    try:
+        descriptor = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a file: a caller's buffer
+        return False
+    try:
+        os.fstat(descriptor)
+    except OSError:
+        return True
+    return False
+
+
 def write_stdout(text: str) -> None:
-    """Print ``text``; a standard output that cannot take it (a full device) is one line."""
+    """Print ``text`` as it is (CSV, JSON), flushed now: a standard output that cannot
+    take it (a full device, closed) is a one-line :class:`StdoutError`."""
+    if sys.stdout is None:
+        raise StdoutError("standard output is closed; redirect it (e.g. > /dev/null)")
     try:
         sys.stdout.write(text)
         sys.stdout.flush()
     except BrokenPipeError:
         raise
     except OSError as exc:
-        raise OutputError(f"standard output: cannot write: {exc.strerror}") from None
+        reason = exc.strerror or type(exc).__name__
+        raise StdoutError(f"standard output: cannot write: {reason}") from None
+
+
+def flush_stdout() -> None:
+    """Flush standard output (what a library printed past :func:`write_stdout`); a
+    failure is a one-line :class:`StdoutError`."""
+    if sys.stdout is None:
+        return
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise StdoutError(f"standard output: cannot write: {reason}") from None
+
+
+def say(text: object = "") -> None:
+    """Print one or more lines of human-readable text (and a new line): every character a
+    terminal would act on is escaped line by line (untrusted.printable), so that text
+    from a file that reached it unescaped still prints inert; then :func:`write_stdout`."""
+    lines = str(text).split("\n")
+    write_stdout("\n".join(printable(line) for line in lines) + "\n")
+
+
+def discard_stdout() -> None:
+    """After standard output failed: point its descriptor at /dev/null, so that what is
+    still buffered does not fail again at exit (Python's "Exception ignored" and exit
+    code 120). Only for a real file descriptor (not a caller's buffer)."""
+    with contextlib.suppress(AttributeError, OSError, ValueError):
+        descriptor = sys.stdout.fileno()
+        null = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(null, descriptor)
+        finally:
+            os.close(null)
 
 
 def csv_text(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:

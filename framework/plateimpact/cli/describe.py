@@ -1,49 +1,86 @@
 """What ``show`` prints about a run: every input (the model's plug-ins and settings, the
-scenes' spheres, plates and impacts) and its provenance (versions, source commit)."""
+scenes' spheres, plates and impacts) and its provenance (versions, source commit).
+
+Everything here comes from an archive, which may come from anyone: every piece of its
+text (names, labels, hosts, settings) goes through :func:`untrusted.printable` before it
+is printed, so that a new line, an escape sequence or a bidirectional override in it
+prints inert, and a value of the wrong type prints as what it is instead of failing.
+"""
 
 from __future__ import annotations
 
+import json
+import math
 from typing import Any
 
 import numpy as np
 
 from ..batch import CORE_COLUMNS, SceneBatch
-from ..errors import UnknownNameError
 from ..parameters import Parameter
 from ..registry import KINDS, default_registry
+from ..results import BatchResult
+from ..storage.archive import Archive
+from ..untrusted import printable
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.
 LISTED_VALUES = 6
+#: Longest piece of an archive's text printed [characters] (a longer one is cut, "...").
+LONGEST_TEXT = 200
+
+
+def shown(value: object, limit: int | None = LONGEST_TEXT) -> str:
+    """Text from a file, as one inert line of at most ``limit`` characters."""
+    return printable(value, limit)
+
+
+def seconds(value: object) -> str:
+    """A duration [s] as ``0.42 s``, or what the archive holds instead of a number."""
+    if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+        return f"{value:.2f} s"
+    return shown(value)
 
 
 def _value(declared: Parameter | None, value: object) -> str:
-    """A value [SI] in the user's unit, with the unit."""
+    """A value [SI] in the user's unit, with the unit; a value the declaration cannot
+    describe (an archive's, of another version of the plug-in) as it is stored."""
     if declared is None:
-        return str(value)
+        return shown(json.dumps(value) if not isinstance(value, str) else value)
     unit = "" if declared.user_unit == "1" or value is None else f" {declared.user_unit}"
-    return f"{declared.format(value)}{unit}"
+    try:
+        return f"{shown(declared.format(value))}{unit}"
+    except Exception:  # a plug-in's own formatting of a stored value: show the value
+        return shown(json.dumps(value, default=str))
 
 
 def _plugin(kind: str, model: dict[str, Any]) -> str:
     """``dopri5 1 (rtol 1e-09, ...)``: name, version and every setting."""
-    try:
-        declarations = default_registry().get(kind, model[kind]).setting_declarations()
-    except UnknownNameError:  # not installed here: the settings as stored [SI]
-        declarations = {}
+    name = model.get(kind)
+    plugins = default_registry()
+    declarations: dict[str, Parameter] = {}
+    if isinstance(name, str) and name in plugins.names(kind):
+        declarations = plugins.get(kind, name).setting_declarations()
+    # not installed here: the settings as stored [SI]
+    stored = model.get(f"{kind}_settings")
     settings = ", ".join(
-        f"{name} {_value(declarations.get(name), value)}"
-        for name, value in model.get(f"{kind}_settings", {}).items()
+        f"{shown(setting)} {_value(declarations.get(setting), value)}"
+        for setting, value in (stored.items() if isinstance(stored, dict) else [])
     )
-    return f"{model[kind]} {model.get(f'{kind}_version', '?')} ({settings or 'no settings'})"
+    version = shown(model.get(f"{kind}_version", "?"))
+    return f"{shown(name)} {version} ({settings or 'no settings'})"
 
 
 def run_lines(meta: dict[str, Any]) -> list[str]:
     """The model, commit and versions of an archived run (its metadata)."""
-    model = meta["model"]
+    model = meta.get("model")
+    model = model if isinstance(model, dict) else {}
     lines = [f"  {kind}: {_plugin(kind, model)}" for kind in KINDS]
-    lines.append(f"  rest_speed_fraction: {model.get('rest_speed_fraction')}")
-    versions = ", ".join(f"{name} {version}" for name, version in meta["versions"].items())
-    lines.append(f"  source commit {meta['git_commit']}; {versions}")
+    lines.append(f"  rest_speed_fraction: {shown(model.get('rest_speed_fraction'))}")
+    found = meta.get("versions")
+    versions = ", ".join(
+        f"{shown(name)} {shown(version)}"
+        for name, version in (found.items() if isinstance(found, dict) else [])
+    )
+    lines.append(f"  source commit {shown(meta.get('git_commit'))}; {versions}")
     return lines
 
 
@@ -51,10 +88,39 @@ def scene_line(scenes: SceneBatch, plate_labels: tuple[str, ...]) -> str:
     """Each scene column: its one value, its few values, or its range [user units]."""
     declared = {**CORE_COLUMNS, **default_registry().plate_constants}
     columns = scenes.columns
-    parts = [f"plates {', '.join(dict.fromkeys(plate_labels))}"]
+    parts = [f"plates {', '.join(shown(label) for label in dict.fromkeys(plate_labels))}"]
     for name in sorted(columns, key=lambda n: (n not in CORE_COLUMNS, n)):
         distinct = [_value(declared.get(name), float(x)) for x in np.unique(columns[name])]
         if len(distinct) > LISTED_VALUES:
             distinct = [f"{distinct[0]} to {distinct[-1]} ({len(distinct)} values)"]
-        parts.append(f"{name} {', '.join(distinct)}")
+        parts.append(f"{shown(name)} {', '.join(distinct)}")
     return "  scenes: " + "; ".join(parts)
+
+
+def run_description(archive: Archive, name: str) -> list[str]:
+    """What ``show`` prints of the run ``name`` (STUDY/RUN)."""
+    meta: dict[str, Any] = archive.metadata(name)
+    result: BatchResult = archive.results(name)
+    counts = np.bincount(result.outcome, minlength=4)[1:]
+    from ..storage.code_provenance import summary  # noqa: PLC0415 (hashing only here)
+
+    lines = [shown(name, None), *run_lines(meta)]
+    # each plug-in's origin and source hash (printable already)
+    lines += [f"  {line}" for line in summary(meta.get("plugins"))]
+    study = archive.study(name.split("/", 1)[0])
+    lines.append(scene_line(study.scenes, study.plate_labels))
+    lines.append(
+        f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
+        f"{counts[2]} perforation; wall {seconds(meta.get('wall_time_s'))}"
+    )
+    kept = [
+        what
+        for what, data in (("trajectories", result.trajectory), ("craters", result.craters))
+        if data is not None
+    ]
+    if kept:
+        lines.append(f"  with {' and '.join(kept)}")
+    lines.append(f"  run {shown(meta.get('start_time'))} on {shown(meta.get('host'))}")
+    data = archive.data_file(name)  # format 2: the run's own netCDF file
+    lines.append(f"  data {shown(data, None)}" if data else "  data in the archive (format 1)")
+    return lines

@@ -12,6 +12,8 @@ from .. import presets
 from ..bodies import MASS, RADIUS, THICKNESS
 from ..parameters import Parameter
 from ..registry import KINDS, PluginRegistry, default_registry
+from .common import say
+from .describe import shown
 
 
 def add_parsers(sub: Any) -> None:
@@ -49,14 +51,14 @@ def presets_command(args: argparse.Namespace) -> None:
         "density_kg_m3": presets.SAE_52100_DENSITY,
     }
     if args.json:
-        print(json.dumps({"plates": rows, "sphere": sphere_row}, indent=2))
+        say(json.dumps({"plates": rows, "sphere": sphere_row}, indent=2))
         return
     keys = list(next(iter(rows.values())))[1:]
-    print(f"{'plate':14s} {'material':9s} " + " ".join(f"{k:>12s}" for k in keys))
+    say(f"{'plate':14s} {'material':9s} " + " ".join(f"{k:>12s}" for k in keys))
     for name, row in rows.items():
         values = " ".join(f"{row[k]:12.4g}" for k in keys)
-        print(f"{name:14s} {row['material']:9s} {values}")
-    print(
+        say(f"{name:14s} {row['material']:9s} {values}")
+    say(
         f"\nsphere (default): SAE 52100, radius {sphere.radius * 1e3:.4g} mm, "
         f"mass {sphere.mass * 1e3:.4f} g, density {presets.SAE_52100_DENSITY:.0f} kg/m^3"
     )
@@ -65,7 +67,7 @@ def presets_command(args: argparse.Namespace) -> None:
 def _details(registry: PluginRegistry, kind: str, name: str) -> list[str]:
     cls = registry.get(kind, name)
     summary = (inspect.getdoc(cls) or "").split("\n")[0]
-    lines = [f"  {name} (version {cls.version}, {cls.__module__}): {summary}"]
+    lines = [f"  {shown(name)} (version {shown(cls.version)}, {cls.__module__}): {shown(summary)}"]
     for setting, declared in cls.setting_declarations().items():
         alias = f", or {declared.flag}" if declared.flag else ""
         lines.append(f"      --set {kind}.{setting}=VALUE{alias}: {declared.help()}")
@@ -81,12 +83,12 @@ def _details(registry: PluginRegistry, kind: str, name: str) -> list[str]:
 def plugins_command(args: argparse.Namespace) -> None:
     registry = default_registry()
     for kind in KINDS:
-        print(f"{kind}: {', '.join(registry.names(kind))}")
+        say(f"{kind}: {', '.join(shown(name) for name in registry.names(kind))}")
         if args.details:
             for name in registry.names(kind):
-                print("\n".join(_details(registry, kind, name)))
+                say("\n".join(_details(registry, kind, name)))
     for package in registry.broken:  # skipped, none of their plug-ins registered
-        print(f"broken: {package.describe()}")
+        say(f"broken: {shown(package.describe(), None)}")
         if args.details and package.provides:
-            named = ", ".join(f"{kind} {name}" for kind, name in package.provides)
-            print(f"  would provide: {named}")
+            named = ", ".join(f"{kind} {shown(name)}" for kind, name in package.provides)
+            say(f"  would provide: {named}")

@@ -17,14 +17,18 @@ from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome
 from ..storage.archive import Archive
+from ..storage.together import write_together
 from .common import (
     UsageError,
     add_dpi_option,
     check_directory,
     csv_text,
+    figure_output,
     save_figure_atomically,
-    write_atomically,
+    say,
+    text_output,
 )
+from .describe import shown
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
 _DEG = math.pi / 180.0
@@ -125,7 +129,7 @@ def _writable_archive(args: argparse.Namespace) -> Archive | None:
 def _store(archive: Archive | None, name: str, found: lim.Limits | lim.OutcomeMap) -> None:
     if archive is not None:
         stored = lim.archive_limits(archive, name.replace("/", "_"), found)
-        print(f"archive: {archive.path} (limits/{stored})")
+        say(f"archive: {archive.path} (limits/{stored})")
 
 
 def _number(text: str, flag: str) -> float:
@@ -222,14 +226,16 @@ def limits_command(args: argparse.Namespace) -> None:
             simulation, sphere, plate, lines, span, tolerance=tolerance, resolution=resolution,
             max_scenes=None if args.force else lim.MAX_SCAN_SCENES,
         )  # fmt: skip
+    outputs = []  # the bands and their figure land together
     if args.csv is not None:
-        write_atomically(args.csv, _csv(found), "--csv")
+        outputs.append(text_output(args.csv, _csv(found), "--csv"))
     if args.png is not None:
         from ..limits.figures import plot_bands  # noqa: PLC0415 (matplotlib when drawing)
 
-        save_figure_atomically(plot_bands(found, label), args.png, dpi=args.dpi)
+        outputs.append(figure_output(plot_bands(found, label), args.png, "--png", args.dpi))
+    write_together(outputs)
     if args.json:
-        print(json.dumps({"preset": label, **found.to_json()}))
+        say(json.dumps({"preset": label, **found.to_json()}))
     else:
         _print(found, label, args.outcome)
     _store(archive, args.name or f"{label}_{simulation.model.failure.name}", found)
@@ -269,8 +275,9 @@ def _print(found: lim.Limits, label: str, outcomes: list[str] | None) -> None:
         else:
             where = f"{line.fixed:g} m/s"
             named = f"critical ricochet obliquity {show(line.critical_ricochet_obliquity)}"
-        print(f"{label} at {where}: {' | '.join(bands) or 'no such band'} {unit}; {named}")
-    print(
+        shown_bands = " | ".join(bands) or "no such band"
+        say(f"{shown(label, None)} at {where}: {shown_bands} {unit}; {named}")
+    say(
         f"boundaries bracketed to {found.tolerance / scale:g} {unit}, no band of "
         f"{found.resolution / scale:g} {unit} missed; {found.scenes:,} scenes in "
         f"{found.seconds:.1f} s ({found.model['integrator']})"
@@ -309,15 +316,15 @@ def map_command(args: argparse.Namespace) -> None:
                                  span, samples, rows, tolerance=tolerance)  # fmt: skip
     maps = [(label, one) for (_, _, label), one in zip(plates, found, strict=True)]
     shape, counted = found[0].shape, found[0].limits
-    print(
-        f"{', '.join(label for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
+    say(
+        f"{', '.join(shown(label, None) for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
         f"{shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
     )
     from ..limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves
     save_figure_atomically(draw(maps), args.png, dpi=args.dpi)
-    print(f"figure:  {args.png}")
+    say(f"figure:  {args.png}")
     failure = simulation.model.failure.name
     for label, drawn in maps:
         name = f"map_{label}_{failure}"

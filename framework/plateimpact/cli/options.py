@@ -19,11 +19,12 @@ import attrs
 from .. import presets
 from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
 from ..model import REST_SPEED_FRACTION, ImpactModel
-from ..parameters import Parameter
+from ..parameters import Parameter, json_literal
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 from ..storage.plate_file import load_plate_file
+from ..untrusted import load_json
 from .common import UsageError
 
 #: The model slots ``--set`` knows besides the plug-in kinds.
@@ -139,7 +140,16 @@ def typed(args: argparse.Namespace) -> dict[str, str]:
 
 def _parse(declared: Parameter, text: str, flag: str, args: argparse.Namespace) -> Any:
     typed(args)[declared.name] = flag
+    if declared.convert is json_literal:  # an undeclared setting: JSON, or else text
+        return _literal(text, flag)  # (its declaration checks nothing more)
     return declared.parse(text)
+
+
+def _literal(text: str, flag: str) -> Any:
+    """The value of ``--set SLOT.NAME=TEXT`` for an undeclared setting: JSON read within
+    untrusted.load_json's bounds (one line naming the flag), or the text itself when it
+    is no JSON at all (``RK23``)."""
+    return load_json(text, flag, UsageError, text_if_not_json=True)
 
 
 class ModelChoice:

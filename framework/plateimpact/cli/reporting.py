@@ -21,6 +21,7 @@ from typing import Protocol, TextIO
 from ..discovery import first_line
 from ..errors import PlateImpactWarning
 from ..storage.provenance import versions
+from ..untrusted import printable
 
 
 class ShowWarning(Protocol):
@@ -50,7 +51,7 @@ def one_line_warnings(shown_before: ShowWarning) -> ShowWarning:
         line: str | None = None,
     ) -> None:
         if issubclass(category, PlateImpactWarning):
-            print(f"plateimpact: warning: {message}", file=file or sys.stderr)
+            print(f"plateimpact: warning: {printable(message)}", file=file or sys.stderr)
         else:
             shown_before(message, category, filename, lineno, file, line)
 
@@ -95,5 +96,5 @@ def report_internal_error(exc: Exception, argv: Sequence[str]) -> int:
         where = f"the traceback is in {write_traceback(exc, argv)}"
     except OSError as error:
         where = f"the traceback could not be written ({error}); run with --debug to see it"
-    print(f"plateimpact: internal error: {first_line(exc)}; {where}", file=sys.stderr)
+    print(f"plateimpact: internal error: {printable(first_line(exc))}; {where}", file=sys.stderr)
     return 1

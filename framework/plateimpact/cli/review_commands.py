@@ -9,7 +9,8 @@ from typing import Any
 from ..errors import ParameterError
 from ..storage.archive import Archive
 from ..storage.output import write_output
-from .common import UsageError, check_directory, csv_text
+from .common import UsageError, check_directory, csv_text, say
+from .describe import shown
 
 
 def add_parsers(sub: Any) -> None:
@@ -36,7 +37,7 @@ def upgrade_command(args: argparse.Namespace) -> None:
     from ..storage.upgrade import upgrade  # noqa: PLC0415
 
     kept = upgrade(args.archive)
-    print(f"upgraded {args.archive} to format 2; the format-1 file is kept as {kept}")
+    say(f"upgraded {args.archive} to format 2; the format-1 file is kept as {kept}")
 
 
 def export_command(args: argparse.Namespace) -> None:
@@ -55,4 +56,4 @@ def export_command(args: argparse.Namespace) -> None:
     else:
         text = csv_text(export.table_header(archive, run), export.table_rows(archive, run))
         write_output(args.to, "--to", lambda handle: handle.write(text.encode()))
-    print(f"wrote {run} to {args.to}")
+    say(f"wrote {shown(run, None)} to {shown(args.to, None)}")

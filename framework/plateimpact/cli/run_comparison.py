@@ -1,4 +1,5 @@
-"""``compare`` of two runs: outcome changes in ranges, as text, counts or JSON."""
+"""``compare`` of two runs: outcome changes in ranges, as text, counts or JSON (run names
+and plate labels, from the archive, printed inert: describe.shown)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ import numpy as np
 
 from ..comparison import Comparison, ComparisonRow, OutcomeRange, Spread
 from ..limits.lines import SPEED
+from .common import say
+from .describe import shown
 
 
 def _place(axis: str, start: float, end: float) -> str:
@@ -16,8 +19,8 @@ def _place(axis: str, start: float, end: float) -> str:
         values, unit = (start, end), "m/s"
     else:
         values, unit = (float(np.degrees(start)), float(np.degrees(end))), "deg"
-    shown = [f"{v:.6g}" for v in values]
-    return f"{shown[0]} {unit}" if shown[0] == shown[1] else f"{shown[0]}-{shown[1]} {unit}"
+    texts = [f"{v:.6g}" for v in values]
+    return f"{texts[0]} {unit}" if texts[0] == texts[1] else f"{texts[0]}-{texts[1]} {unit}"
 
 
 def _count(count: int, thing: str) -> str:
@@ -30,7 +33,7 @@ def _scenes(count: int) -> str:
 
 def _head(comparison: Comparison, changed: int, ranges: int) -> str:
     return (
-        f"B {comparison.run_b} against A {comparison.run_a}: "
+        f"B {shown(comparison.run_b, None)} against A {shown(comparison.run_a, None)}: "
         f"{_scenes(len(comparison.scenes))}, {changed} with another outcome in "
         f"{_count(ranges, 'range')}"
     )
@@ -49,7 +52,7 @@ def _spread(spread: Spread) -> str:
 
 def _row_head(row: ComparisonRow) -> str:
     at = f"{float(np.degrees(row.fixed)):.6g} deg" if row.axis == SPEED else f"{row.fixed:.6g} m/s"
-    return f"{row.plate} at {at}, {_place(row.axis, row.start, row.end)}"
+    return f"{shown(row.plate)} at {at}, {_place(row.axis, row.start, row.end)}"
 
 
 def _range(change: OutcomeRange) -> str:
@@ -93,6 +96,6 @@ def print_comparison(comparison: Comparison, *, as_json: bool, summary: bool) ->
     if as_json:
         runs = {"a": comparison.run_a, "b": comparison.run_b}
         found = {**runs, **comparison.summary()} if summary else comparison.to_json()
-        print(json.dumps(found, indent=2))
+        say(json.dumps(found, indent=2))
     else:
-        print(summary_text(comparison) if summary else text(comparison))
+        say(summary_text(comparison) if summary else text(comparison))

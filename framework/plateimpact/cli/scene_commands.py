@@ -17,17 +17,19 @@ from ..results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
 from ..storage.inputs import load_run_inputs
-from ..storage.output import stream_text
 from ..storage.provenance import inputs_record
+from ..storage.together import write_together
 from .common import (
     UsageError,
     add_dpi_option,
     check_directory,
     csv_text,
-    save_figure_atomically,
-    write_atomically,
+    figure_output,
+    say,
+    text_output,
     write_stdout,
 )
+from .describe import shown
 from .options import (
     add_body_options,
     add_model_options,
@@ -36,6 +38,7 @@ from .options import (
     model_choice,
     scene_flags,
 )
+from .sidecar import csv_and_sidecar, sidecar
 from .sweep_csv import Sweep
 
 #: The largest sweep without --force: a million scenes take about a minute and a half
@@ -131,6 +134,7 @@ def _user(declared: Parameter, scene: Scene) -> float:
 
 def run_command(args: argparse.Namespace) -> None:
     check_directory(args.trajectory, "--trajectory")
+    check_directory(args.trajectory and sidecar(args.trajectory), "--trajectory", "json")
     if args.inputs is not None:
         scene, simulation, label = _recorded_scene(args)
     else:
@@ -141,13 +145,25 @@ def run_command(args: argparse.Namespace) -> None:
             )
         scene, simulation, label = _scene(args)
     result = simulation.run(scene, record_trajectory=args.trajectory is not None)
-    if args.trajectory is not None and result.trajectory is not None:
+    speed, obliquity = (_user(d, scene) for d in (IMPACT_SPEED, IMPACT_OBLIQUITY))
+    # the record (source commit, code hashes) only where it is written or printed
+    inputs = None
+    if args.json or args.trajectory is not None:
+        inputs = inputs_record(
+            simulation,
+            scene.sphere,
+            scene.plate,
+            label=label,
+            scene={IMPACT_SPEED: scene.impact_speed, IMPACT_OBLIQUITY: scene.impact_obliquity},
+        )
+    if args.trajectory is not None and result.trajectory is not None and inputs is not None:
         path = result.trajectory
         fields = list(TRAJECTORY_FIELDS.values())
         rows = zip(*(getattr(path, f.name) / f.scale for f in fields), strict=True)
-        write_atomically(args.trajectory, csv_text([f.key for f in fields], rows), "--trajectory")
-    speed, obliquity = (_user(d, scene) for d in (IMPACT_SPEED, IMPACT_OBLIQUITY))
-    if args.json:  # the record (source commit, code hashes) only where it is printed
+        text = csv_text([f.key for f in fields], rows)
+        # the path and, beside it, the run's inputs (run --inputs reads them): together
+        write_together(csv_and_sidecar(args.trajectory, "--trajectory", [text], inputs))
+    if args.json:
         out: dict[str, Any] = {
             "preset": label,
             IMPACT_SPEED.key: speed,
@@ -155,27 +171,21 @@ def run_command(args: argparse.Namespace) -> None:
         }
         out.update(result.as_user_dict())
         out["model"] = simulation.describe()
-        out["inputs"] = inputs_record(
-            simulation,
-            scene.sphere,
-            scene.plate,
-            label=label,
-            scene={IMPACT_SPEED: scene.impact_speed, IMPACT_OBLIQUITY: scene.impact_obliquity},
-        )
-        print(json.dumps(out))
+        out["inputs"] = inputs
+        say(json.dumps(out))
         return
-    print(f"{label}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
-    print(f"  exit speed       {result.exit_speed:.6g} m/s")
-    print(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
-    print(f"  contact time     {result.contact_time * 1e6:.6g} us")
-    print(f"  max penetration  {result.max_penetration * 1e3:.6g} mm")
+    say(f"{shown(label, None)}: {speed:g} m/s at {obliquity:g} deg -> {result.outcome.label}")
+    say(f"  exit speed       {result.exit_speed:.6g} m/s")
+    say(f"  exit obliquity   {result.exit_obliquity_deg:.6g} deg")
+    say(f"  contact time     {result.contact_time * 1e6:.6g} us")
+    say(f"  max penetration  {result.max_penetration * 1e3:.6g} mm")
     if result.plate_failed:
-        print(
+        say(
             f"  plate failed     at P = {result.failure_penetration * 1e3:.6g} mm, "
             f"Y = {result.failure_lateral * 1e3:.6g} mm, t = {result.failure_time * 1e6:.6g} us"
         )
     else:
-        print("  plate failed     no")
+        say("  plate failed     no")
 
 
 def crater_command(args: argparse.Namespace) -> None:
@@ -187,15 +197,16 @@ def crater_command(args: argparse.Namespace) -> None:
     section = crater_section(
         result.trajectory, scene.sphere.radius, thickness=scene.plate.thickness
     )
-    print(
-        f"{label}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
+    say(
+        f"{shown(label, None)}: {float(args.speed):g} m/s at {float(args.obliquity):g} deg -> "
         f"{result.outcome.label}; crater {section.length * 1e3:.4g} mm long, "
         f"{section.max_depth * 1e3:.4g} mm deep"
     )
+    outputs = []  # the section and its figure land together
     if args.csv is not None:
         lateral, depth = CRATER_FIELDS["lateral"], CRATER_FIELDS["depth"]
         rows = zip(section.lateral / lateral.scale, section.depth / depth.scale, strict=True)
-        write_atomically(args.csv, csv_text([lateral.key, depth.key], rows), "--csv")
+        outputs.append(text_output(args.csv, csv_text([lateral.key, depth.key], rows), "--csv"))
     if args.png is not None:
         from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
@@ -203,7 +214,8 @@ def crater_command(args: argparse.Namespace) -> None:
         plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
         speed, obliquity = float(args.speed), float(args.obliquity)
         ax.set_title(f"{label}, {speed:g} m/s at {obliquity:g}°: {result.outcome.label}")
-        save_figure_atomically(fig, args.png, dpi=args.dpi)
+        outputs.append(figure_output(fig, args.png, "--png", args.dpi))
+    write_together(outputs)
 
 
 def _parse_speeds(text: str) -> np.ndarray:
@@ -232,17 +244,11 @@ def _parse_obliquities(text: str) -> np.ndarray:
         raise UsageError(f"--obliquities must be a comma list in degrees, got {text!r}") from None
 
 
-def sidecar(csv_path: str) -> str:
-    """Where a sweep's inputs and provenance go beside its CSV: FILE.json for --csv FILE
-    (the CSV stays plain for any CSV reader)."""
-    return f"{csv_path}.json"
-
-
-def write_sweep_inputs(
+def sweep_inputs(
     args: argparse.Namespace, simulation: Simulation, sphere: Sphere, plate: Plate, label: str
-) -> None:
-    """The inputs record of a sweep (storage.provenance), beside its --csv file."""
-    record = inputs_record(
+) -> dict[str, Any]:
+    """The inputs record of a sweep (storage.provenance), for the sidecar of its --csv."""
+    return inputs_record(
         simulation,
         sphere,
         plate,
@@ -250,8 +256,6 @@ def write_sweep_inputs(
         speeds_m_s=args.speeds,
         obliquities_deg=args.obliquities,
     )
-    write_atomically(sidecar(args.csv), json.dumps(record, indent=2) + "\n", "--csv")
-    print(f"inputs and provenance: {sidecar(args.csv)}")
 
 
 def _check_sweep_size(speeds: int, obliquities: int, force: bool) -> None:
@@ -280,9 +284,11 @@ def sweep_command(args: argparse.Namespace) -> None:
             for text in texts:
                 write_stdout(text)
             return
-        stream_text(args.csv, texts, "--csv")
-    print(
-        f"wrote {sweep.size} scenes to {args.csv}: "
+        record = sweep_inputs(args, simulation, sphere, plate, label)
+        # the CSV and, beside it, what it holds: together, tied by the CSV's SHA-256
+        write_together(csv_and_sidecar(args.csv, "--csv", texts, record))
+    say(
+        f"wrote {sweep.size} scenes to {shown(args.csv, None)}: "
         + ", ".join(f"{sweep.counts[o]} {o.label}" for o in Outcome)
     )
-    write_sweep_inputs(args, simulation, sphere, plate, label)
+    say(f"inputs and provenance: {shown(sidecar(args.csv), None)}")

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Any
 
 from ..errors import UnknownNameError
 from ..limits import LimitsComparison, OutcomeMap, compare_limits, read_limits
@@ -13,7 +12,8 @@ from ..limits.lines import OBLIQUITY, SPEED, LimitLine
 from ..limits.records import KIND_MAP, NAMES, attributes_of
 from ..storage.archive import Archive
 from ..storage.records import LIMITS
-from .common import UsageError
+from .common import UsageError, say
+from .describe import seconds, shown
 
 _UNIT = {SPEED: "m/s", OBLIQUITY: "deg"}
 
@@ -46,32 +46,49 @@ def _named(axis: str, line: LimitLine, digits: int) -> str:
     return ", ".join(parts)
 
 
-def _model(model: dict[str, Any]) -> str:
+def _model(model: object) -> str:
+    """The stored model (an archive's JSON) as one inert line."""
+    if not isinstance(model, dict):
+        return shown(model)
+
     def slot(kind: str) -> str:
         settings = model.get(f"{kind}_settings") or {}
         return f"{model.get(kind)}" + (f" {settings}" if settings else "")
 
-    return (
+    return shown(
         f"{slot('resistance')} + {slot('failure')}, rest_speed_fraction "
         f"{model.get('rest_speed_fraction')}, integrator {model.get('integrator')} "
         f"{model.get('integrator_settings')}"
     )
 
 
+def _plate(plate: object) -> str:
+    """``2024-T3 3.18 mm (a_N_m2 1.01e+09, ...)`` from a stored plate object."""
+    if not isinstance(plate, dict):
+        return shown(plate)
+    constants = ", ".join(
+        f"{shown(k)} {v:g}"
+        for k, v in plate.items()
+        if isinstance(v, float) and k != "thickness_mm"
+    )
+    thickness = plate.get("thickness_mm")
+    number = isinstance(thickness, int | float) and not isinstance(thickness, bool)
+    return (
+        f"{shown(plate.get('material'))} {f'{thickness:g}' if number else shown(thickness)} mm "
+        f"({constants})"
+    )
+
+
 def show_stored(archive: Archive) -> None:
     """Print every stored limits and map: what, plate, model, tolerance and resolution,
-    then one line per line with its named limits."""
+    then one line per line with its named limits. Every piece of the archive's text is
+    printed inert (describe.shown)."""
     for name in archive.limits_names():
         found = read_limits(archive, name)
         meta = attributes_of(archive, name)
         limits = found.limits if isinstance(found, OutcomeMap) else found
         axis, unit = limits.axis, _UNIT[limits.axis]
-        plate = meta["plate"]
-        constants = ", ".join(
-            f"{k} {v:g}" for k, v in plate.items() if isinstance(v, float) and k != "thickness_mm"
-        )
-        if meta["kind"] == KIND_MAP:
-            assert isinstance(found, OutcomeMap)
+        if meta.get("kind") == KIND_MAP and isinstance(found, OutcomeMap):
             rows, columns = found.shape
             degrees = [user(OBLIQUITY, x) for x in (found.obliquities[0], found.obliquities[-1])]
             what = (
@@ -81,20 +98,23 @@ def show_stored(archive: Archive) -> None:
         else:
             what = f"limits along {NAMES[axis]}, {len(limits.lines)} line(s)"
         digits = _digits(axis, limits.tolerance)
-        print(f"{LIMITS}/{name}: {what}")
-        print(f"  plate {plate['material']} {plate['thickness_mm']:g} mm ({constants})")
-        print(f"  model: {_model(limits.model)}")
-        print(
+        versions = meta.get("versions")
+        version = versions.get("plateimpact") if isinstance(versions, dict) else versions
+        lines = [
+            f"{LIMITS}/{shown(name, None)}: {what}",
+            f"  plate {_plate(meta.get('plate'))}",
+            f"  model: {_model(limits.model)}",
             f"  tolerance {user(axis, limits.tolerance):g} {unit}, resolution "
             f"{user(axis, limits.resolution):g} {unit}; {limits.scenes} scenes, "
-            f"{limits.passes} passes, wall {limits.seconds:.2f} s"
-        )
-        for line in limits.lines:
-            print(f"  {_fixed(axis, line.fixed)}: {_named(axis, line, digits)}")
-        print(
-            f"  made {meta['creation_time']} on {meta['host']}, plateimpact "
-            f"{meta['versions'].get('plateimpact')}, commit {str(meta['git_commit'])[:12]}"
-        )
+            f"{limits.passes} passes, wall {seconds(limits.seconds)}",
+            *(
+                f"  {_fixed(axis, line.fixed)}: {_named(axis, line, digits)}"
+                for line in limits.lines
+            ),
+            f"  made {shown(meta.get('creation_time'))} on {shown(meta.get('host'))}, plateimpact "
+            f"{shown(version)}, commit {shown(str(meta.get('git_commit'))[:12])}",
+        ]
+        say("\n".join(lines))
 
 
 def _is_stored(name: str, stored: list[str]) -> bool:
@@ -141,6 +161,7 @@ def _text(name_a: str, name_b: str, comparison: LimitsComparison) -> str:
     def at(value: float | None) -> str:
         return "-" if value is None else f"{user(axis, value):.{digits}f}"
 
+    name_a, name_b = shown(name_a, None), shown(name_b, None)
     out = [
         f"{name_b} against {name_a}: {len(comparison.lines)} line(s) along {NAMES[axis]} "
         f"in both (shift: {name_b} - {name_a})"
@@ -184,6 +205,6 @@ def compare_stored(archive: Archive, name_a: str, name_b: str, as_json: bool) ->
         )
     comparison = compare_limits(a, b)
     if as_json:
-        print(json.dumps({"a": name_a, "b": name_b, **comparison.to_json()}, indent=2))
+        say(json.dumps({"a": name_a, "b": name_b, **comparison.to_json()}, indent=2))
         return
-    print(_text(name_a, name_b, comparison))
+    say(_text(name_a, name_b, comparison))

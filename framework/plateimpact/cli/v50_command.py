@@ -20,7 +20,8 @@ from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP
 from ..v50.likelihood import shown as count_shown
-from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically
+from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically, say
+from .describe import shown
 from .options import add_body_options, add_model_options, bodies, model_choice, typed
 
 MIL_STD = "mil-std-662f"
@@ -215,12 +216,12 @@ def v50_command(args: argparse.Namespace) -> None:
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     rows = [_json(args, o, r, groups[o].labels, model_limits, model) for o, r in results.items()]
     if args.json:
-        print(json.dumps(rows[0] if len(rows) == 1 else rows))
+        say(json.dumps(rows[0] if len(rows) == 1 else rows))
     else:
         for row in rows:
-            print(_text(row))
+            say(_text(row))
         if args.png is not None:
-            print(f"figure: {args.png}")
+            say(f"figure: {args.png}")
 
 
 def _json(
@@ -253,9 +254,9 @@ def _interval(interval: list[float | None] | None) -> str:
 
 
 def _text(row: dict[str, Any]) -> str:
-    where = f"{row['shots_file']} at {row['obliquity_deg']:g} deg"
+    where = f"{shown(row['shots_file'], None)} at {row['obliquity_deg']:g} deg"
     if "error" in row:
-        lines = [f"{where}: no V50: {row['error']}"]
+        lines = [f"{where}: no V50: {shown(row['error'], None)}"]
     elif row["method"] == MIL_STD:
         partial = ", ".join(f"{v:g}" for v in row["partial_speeds_m_s"])
         complete = ", ".join(f"{v:g}" for v in row["complete_speeds_m_s"])
@@ -289,6 +290,6 @@ def _text(row: dict[str, Any]) -> str:
         lines.append(f"  {note}")
     if "model" in row:
         limit = row["model_ballistic_limit_m_s"]
-        shown = "none in the speeds searched" if limit is None else f"{limit:.2f} m/s"
-        lines.append(f"  model ({row['model']}): ballistic limit {shown}")
+        limit_text = "none in the speeds searched" if limit is None else f"{limit:.2f} m/s"
+        lines.append(f"  model ({shown(row['model'], None)}): ballistic limit {limit_text}")
     return "\n".join(lines)

@@ -14,7 +14,8 @@ from ..experiment.validation import MAX_VALIDATE_SCENES
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..storage.shots import Shots
-from .common import add_dpi_option, check_directory, save_figure_atomically
+from .common import add_dpi_option, check_directory, save_figure_atomically, say
+from .describe import shown
 from .options import add_body_options, add_model_options, bodies, model_choice
 
 #: Disagreeing shots listed in the text output (--json lists all).
@@ -80,7 +81,7 @@ def validate_command(args: argparse.Namespace) -> None:
     if args.png is not None:
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     if args.json:
-        print(json.dumps({"shots_file": args.shots, "plate_label": label, **report.to_json()}))
+        say(json.dumps({"shots_file": args.shots, "plate_label": label, **report.to_json()}))
     else:
         _print_text(args, label, report)
 
@@ -93,34 +94,34 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
     angles = ", ".join(f"{math.degrees(o):.6g}" for o in obliquities[:LISTED])
     if obliquities.size > LISTED:
         angles += f", ... ({obliquities.size:,} obliquities)"
-    print(
-        f"{label}: {len(shots)} shots from {args.shots}"
+    say(
+        f"{shown(label, None)}: {len(shots)} shots from {shown(args.shots, None)}"
         + (f" ({go_no_go} go/no-go)" if go_no_go else "")
-        + f" at {angles} deg; model {model['resistance']} + {model['failure']} "
-        f"({model['integrator']})"
+        + f" at {angles} deg; model {shown(model['resistance'])} + {shown(model['failure'])} "
+        f"({shown(model['integrator'])})"
     )
-    print(f"outcome agreement {100 * report.agreement:.1f}% (weighted)")
+    say(f"outcome agreement {100 * report.agreement:.1f}% (weighted)")
     width = max(len(name) for name in MEASURED) + 2
-    print(f"  {'measured -> model':{width}s}" + "".join(f"{p:>13s}" for p in PREDICTED))
+    say(f"  {'measured -> model':{width}s}" + "".join(f"{p:>13s}" for p in PREDICTED))
     for name in MEASURED:
         counts = report.confusion[name]
         if any(counts.values()):
-            print(f"  {name:{width}s}" + "".join(f"{counts[p]:13d}" for p in PREDICTED))
+            say(f"  {name:{width}s}" + "".join(f"{counts[p]:13d}" for p in PREDICTED))
     pairs = int(np.isfinite(report.residual_speed_error).sum())
     if pairs:
-        print(
+        say(
             f"residual speed, model - measured: rms {report.residual_speed_rms:.3g} m/s, "
             f"bias {report.residual_speed_bias:+.3g} m/s over {pairs} shots"
         )
     else:
-        print("residual speed: no shot where shot and model leave the plate the same way")
+        say("residual speed: no shot where shot and model leave the plate the same way")
     pairs = int(np.isfinite(report.exit_obliquity_error).sum())
     if pairs:
         rms = math.degrees(report.exit_obliquity_rms)
-        print(f"exit obliquity, model - measured: rms {rms:.3g} deg over {pairs} shots")
+        say(f"exit obliquity, model - measured: rms {rms:.3g} deg over {pairs} shots")
     wrong = report.disagreements
     if wrong:
-        print(f"{len(wrong)} shots disagree (distance to the nearest speed the model agrees at):")
+        say(f"{len(wrong)} shots disagree (distance to the nearest speed the model agrees at):")
     for d in wrong[:LISTED]:
         where = (
             f"{d.distance:.3g} m/s from the boundary at {d.boundary:.2f} m/s"
@@ -129,11 +130,11 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
         )
         line = d.label.removeprefix(f"{args.shots} ")  # the file is named above
         angle = math.degrees(d.impact_obliquity)
-        print(
-            f"  {line}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured {d.measured}, "
-            f"model {d.predicted}; {where}"
+        say(
+            f"  {shown(line, None)}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured "
+            f"{d.measured}, model {d.predicted}; {where}"
         )
     if len(wrong) > LISTED:
-        print(f"  ... and {len(wrong) - LISTED} more (--json lists all)")
+        say(f"  ... and {len(wrong) - LISTED} more (--json lists all)")
     if args.png is not None:
-        print(f"figure: {args.png}")
+        say(f"figure: {args.png}")

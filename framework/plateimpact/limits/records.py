@@ -26,7 +26,7 @@ from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import git_commit, versions
 from ..storage.records import Column, Record
-from ..storage.untrusted import printable
+from ..untrusted import printable
 from .find import Limits
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap

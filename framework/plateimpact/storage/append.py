@@ -27,6 +27,7 @@ from ..errors import ArchiveError
 from ..parameters import Parameter
 from ..registry import default_registry
 from ..results import BatchResult
+from ..untrusted import printable
 from ..variant import Variant
 from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed
@@ -39,7 +40,6 @@ from .data_files import (  # noqa: F401 (data_directory and encoded: their publi
 )
 from .hdf5 import seal
 from .netcdf import write_run_file, write_scenes_file
-from .untrusted import printable
 
 FORMAT, FORMAT_VERSION = "plateimpact-archive", 2
 #: Versions this plateimpact reads; it appends to FORMAT_VERSION only.

@@ -27,6 +27,7 @@ from ..batch import SceneBatch
 from ..errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
 from ..parameters import Parameter
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from ..untrusted import printable
 from ..variant import Variant
 from . import append as append_module
 from . import records
@@ -40,7 +41,6 @@ from .confined import data_file_name
 from .lock import ArchiveBusyError, locked
 from .reader import ArchiveFiles
 from .records import LIMITS, Record
-from .untrusted import printable
 from .writable import check_writable, side_archive
 
 #: How long a writer waits for another one to finish with the archive [s].

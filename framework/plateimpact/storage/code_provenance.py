@@ -18,8 +18,8 @@ from typing import Any
 from ..plugin import Plugin
 from ..registry import KINDS, plugin_origin
 from ..simulation import Simulation
+from ..untrusted import printable
 from .source_hash import module_sources, source_sha256
-from .untrusted import printable
 
 #: The core's distribution, and the module whose imports, transitively, are the core
 #: code every run executes (the model, its events, the driver, the results).

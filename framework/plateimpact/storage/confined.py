@@ -37,8 +37,8 @@ from typing import BinaryIO
 import numpy as np
 
 from ..errors import ArchiveError
+from ..untrusted import printable
 from .output import TEMPORARY_EXTRA, pid_alive, temporary_owner, umask
-from .untrusted import printable
 
 #: A data file's name: ``SLUG.XXXXXXXX.nc`` (the slug of study and run, at most 60
 #: characters; 8 random hexadecimal digits).

@@ -23,8 +23,8 @@ import h5py
 from h5py import h5d, h5l, h5o
 
 from ..errors import ArchiveError
+from ..untrusted import printable
 from .confined import Opened, data_file_name, directory, is_hdf5, open_regular
-from .untrusted import printable
 
 #: The most links a file of an archive may hold (an index of 10**5 runs holds about
 #: 2 x 10**5; a run's file about 40); more is not an archive, and is not walked further.

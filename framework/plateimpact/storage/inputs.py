@@ -22,7 +22,6 @@ a plate file's object.
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
 from typing import Any
@@ -37,11 +36,13 @@ from ..plugin import Plugin
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
+from ..untrusted import described, load_json_file, printable
 from .plate_file import plate_from_dict
 
 FORMAT = "plateimpact-inputs-1"
-#: Keys of a record that are provenance or description, not read back.
-RECORD_ONLY = ("format", "label", "versions", "source_commit", "plugins")
+#: Keys of a record that are provenance or description, not read back (``csv_sha256``:
+#: the trajectory a ``run --trajectory`` sidecar describes, cli.sidecar).
+RECORD_ONLY = ("format", "label", "versions", "source_commit", "plugins", "csv_sha256")
 
 
 def si_key(declared: Parameter) -> str:
@@ -105,7 +106,9 @@ def _read_quantity(data: Mapping[str, Any], declared: Parameter, where: str) -> 
     if value is None and declared.optional:
         return None
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputsError(f"{where}{key}: must be a number, got {value!r:.60}")
+        raise InputsError(
+            f"{where}{key}: must be a number {declared.describe_range()}, got {described(value)}"
+        )
     scale = declared.scale if key == declared.key else 1.0
     try:
         return declared.validate(value * scale)
@@ -116,7 +119,7 @@ def _read_quantity(data: Mapping[str, Any], declared: Parameter, where: str) -> 
 def _object(data: Mapping[str, Any], key: str, where: str) -> dict[str, Any]:
     value = data.get(key)
     if not isinstance(value, dict):
-        raise InputsError(f"{where}{key}: expected a JSON object, got {value!r:.60}")
+        raise InputsError(f"{where}{key}: expected a JSON object, got {described(value)}")
     return value
 
 
@@ -124,7 +127,9 @@ def _no_unknown(data: Mapping[str, Any], known: set[str], where: str) -> None:
     """A misspelled key is an error, never silently ignored."""
     extra = sorted(set(data) - known)
     if extra:
-        raise InputsError(f"{where}{extra[0]}: unknown key (known: {', '.join(sorted(known))})")
+        raise InputsError(
+            f"{where}{printable(extra[0], 60)}: unknown key (known: {', '.join(sorted(known))})"
+        )
 
 
 def _keys(*declarations: Parameter) -> set[str]:
@@ -160,7 +165,7 @@ def read_simulation(
     for kind in KINDS:
         name = data.get(kind)
         if not isinstance(name, str):
-            raise InputsError(f"{where}{kind}: expected a plug-in name, got {name!r:.60}")
+            raise InputsError(f"{where}{kind}: expected a plug-in name, got {described(name)}")
         names[kind] = name
     settings = {
         kind: _settings(
@@ -230,12 +235,5 @@ def load_run_inputs(
     path: str | os.PathLike[str], registry: PluginRegistry | None = None
 ) -> RunInputs:
     """The scene and simulation recorded in a file (``run --json``'s output)."""
-    source = os.fspath(path)
-    try:
-        with open(source, encoding="utf-8-sig") as handle:
-            data = json.load(handle)
-    except OSError as exc:
-        raise InputsError(f"{source}: cannot read: {exc.strerror}") from None
-    except (ValueError, UnicodeDecodeError) as exc:  # JSONDecodeError is a ValueError
-        raise InputsError(f"{source}: not valid JSON: {str(exc).splitlines()[0]}") from None
-    return read_run_inputs(data, source, registry)
+    data = load_json_file(path, InputsError)  # bounded: nesting, digits, size, duplicates
+    return read_run_inputs(data, printable(os.fspath(path), 200), registry)

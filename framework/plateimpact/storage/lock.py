@@ -30,7 +30,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..errors import ArchiveError, ArchiveWaitWarning
-from .untrusted import printable
+from ..untrusted import printable
 
 #: How often a waiting writer looks again [s].
 POLL = 0.05

@@ -25,8 +25,8 @@ from ..errors import ArchiveError
 from ..parameters import Parameter
 from ..ragged import Ragged
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from ..untrusted import load_json
 from .hdf5 import digest
-from .untrusted import load_json
 
 SCENE, SAMPLE, POINT = "scene", "trajectory_sample", "crater_point"
 #: The per-scene label of the plate, a string coordinate.

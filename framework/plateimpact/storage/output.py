@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import glob
+import hashlib
 import os
 import re
 import stat
@@ -25,6 +26,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import PlateImpactError
+from ..untrusted import printable
 
 #: What ``kind`` may end with; ``None``: any name.
 SUFFIXES: dict[str, tuple[str, ...] | None] = {
@@ -89,12 +91,44 @@ def unwritable(directory: str | os.PathLike[str]) -> str:
     return "not writable"
 
 
+def shown_path(text: str, limit: int = 200) -> str:
+    """A path for a one-line message: quoted, escaped, cut to ``limit`` characters."""
+    return printable(repr(text), limit)
+
+
+def check_path(real: Path, flag: str, spare: int = 0) -> None:
+    """Refuse a path the filesystem could not take: longer than PATH_MAX (less ``spare``
+    bytes kept for names inside it), a name in it longer than NAME_MAX, or a name in it
+    that is a file where a directory must be."""
+    longest = path_max("/") - 1 - spare
+    size = len(os.fsencode(real))
+    if size > longest:
+        room = f", {spare} kept for the files inside" if spare else ""
+        raise OutputError(
+            f"{flag}: the path is {size:,} bytes; at most {longest:,} are written (PATH_MAX "
+            f"{path_max('/')}{room})"
+        )
+    ancestor = real
+    while not os.path.lexists(ancestor) and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    for part in real.relative_to(ancestor).parts if ancestor != real else ():
+        most = _name_max(str(ancestor) if os.path.isdir(ancestor) else "/")
+        if len(os.fsencode(part)) > most:
+            raise OutputError(
+                f"{flag}: the name {shown_path(part, 60)} is longer than {most} bytes"
+            )
+    if real != ancestor and not os.path.isdir(ancestor):
+        raise OutputError(f"{flag}: {shown_path(str(ancestor))} is not a directory")
+
+
 def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> Path:
     """The real file ``path`` names (links followed), after refusing what cannot be
     written there. Call it before any computation."""
     text = os.fspath(path)
     if not text.strip():
         raise OutputError(f"{flag}: give a file name, got {text!r}")
+    if "\0" in text:
+        raise OutputError(f"{flag}: a file name cannot hold a NUL character")
     longest = path_max("/") - 1 - TEMPORARY_EXTRA  # with its NUL, and its temporary's name
     if len(os.fsencode(text)) > longest:
         raise OutputError(
@@ -108,40 +142,76 @@ def check_output(path: str | os.PathLike[str], flag: str, kind: str = "csv") -> 
             f"are written (PATH_MAX {path_max('/')})"
         )
     directory = str(real.parent)
+    check_path(real, flag, TEMPORARY_EXTRA)
     if os.path.isdir(directory) and len(real.name.encode()) > _name_max(directory):
         raise OutputError(f"{flag}: the file name is longer than {_name_max(directory)} bytes")
     if text.endswith(os.sep) or real.is_dir():
-        raise OutputError(f"{flag}: {text!r} is a directory; give a file name")
+        raise OutputError(f"{flag}: {shown_path(text)} is a directory; give a file name")
     if not os.path.isdir(directory):
-        raise OutputError(f"{flag}: directory {directory!r} does not exist")
+        raise OutputError(f"{flag}: directory {shown_path(directory)} does not exist")
     if not os.access(directory, os.W_OK | os.X_OK):
-        raise OutputError(f"{flag}: directory {directory!r} is {unwritable(directory)}")
+        raise OutputError(f"{flag}: directory {shown_path(directory)} is {unwritable(directory)}")
     if real.exists() or real.is_symlink():
         try:
             mode = os.stat(real).st_mode
         except OSError as exc:
-            raise OutputError(f"{flag}: {text!r} cannot be examined: {exc.strerror}") from None
+            raise OutputError(
+                f"{flag}: {shown_path(text)} cannot be examined: {exc.strerror}"
+            ) from None
         if not stat.S_ISREG(mode):
-            raise OutputError(f"{flag}: {text!r} is not a regular file; refusing to replace it")
+            raise OutputError(
+                f"{flag}: {shown_path(text)} is not a regular file; refusing to replace it"
+            )
         if not mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
-            raise OutputError(f"{flag}: {text!r} is read-only; refusing to replace it")
+            raise OutputError(f"{flag}: {shown_path(text)} is read-only; refusing to replace it")
     suffixes = SUFFIXES.get(kind)
     if suffixes is not None and real.suffix.lower() not in suffixes:
         raise OutputError(
-            f"{flag}: cannot tell the format of {text!r}; end the name with one of "
+            f"{flag}: cannot tell the format of {shown_path(text)}; end the name with one of "
             f"{', '.join(suffixes)}"
         )
     return real
 
 
-def write_output(
+class Prepared:
+    """An output written in full to its temporary file beside ``target`` (flushed,
+    fsynced, given the target's mode), not yet in place: :meth:`commit` renames it over
+    the target, :meth:`discard` removes it (nothing after a commit)."""
+
+    def __init__(self, path: str, flag: str, target: Path, temporary: str) -> None:
+        self.path, self.flag, self.target, self.temporary = path, flag, target, temporary
+
+    def commit(self) -> None:
+        """Rename the temporary file over the target (atomic) and make it durable."""
+        try:
+            fault_point("replace")
+            os.replace(self.temporary, self.target)
+        except OSError as exc:
+            raise _write_error(self.flag, self.path, exc) from None
+        self.temporary = ""
+        fsync_directory(self.target.parent)
+
+    def discard(self) -> None:
+        if self.temporary:
+            with contextlib.suppress(OSError):
+                os.unlink(self.temporary)
+            self.temporary = ""
+
+
+def _write_error(flag: str, path: str, exc: OSError) -> OutputError:
+    reason = exc.strerror or os.strerror(exc.errno or errno.EIO)
+    return OutputError(f"{flag}: cannot write {shown_path(path)}: {reason}")
+
+
+def prepare_output(
     path: str | os.PathLike[str],
     flag: str,
     write: Callable[[IO[bytes]], object],
     kind: str = "csv",
-) -> Path:
-    """Write the file ``path`` atomically with ``write(handle)`` (a binary handle); the
-    target's mode and group are kept. Returns the real path written."""
+) -> Prepared:
+    """The file ``path`` written with ``write(handle)`` (a binary handle) to a temporary
+    file beside it, ready to :meth:`~Prepared.commit`; a failure at any stage removes
+    the temporary file and leaves the target as it was."""
     target = check_output(path, flag, kind)
     remove_dead_temporaries(target)
     temporary = ""
@@ -157,18 +227,30 @@ def write_output(
             os.fsync(handle.fileno())
         fault_point("chmod")
         keep_mode(temporary, target)
-        fault_point("replace")
-        os.replace(temporary, target)
-        temporary = ""
-        fsync_directory(target.parent)
-    except OSError as exc:
-        reason = exc.strerror or os.strerror(exc.errno or errno.EIO)
-        raise OutputError(f"{flag}: cannot write {os.fspath(path)!r}: {reason}") from None
-    finally:
+    except BaseException as exc:  # an interrupt midway too: no temporary file left
         if temporary:
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
-    return target
+        if isinstance(exc, OSError):
+            raise _write_error(flag, os.fspath(path), exc) from None
+        raise
+    return Prepared(os.fspath(path), flag, target, temporary)
+
+
+def write_output(
+    path: str | os.PathLike[str],
+    flag: str,
+    write: Callable[[IO[bytes]], object],
+    kind: str = "csv",
+) -> Path:
+    """Write the file ``path`` atomically with ``write(handle)`` (a binary handle); the
+    target's mode and group are kept. Returns the real path written."""
+    prepared = prepare_output(path, flag, write, kind)
+    try:
+        prepared.commit()
+    finally:
+        prepared.discard()
+    return prepared.target
 
 
 def write_text(path: str | os.PathLike[str], text: str, flag: str, kind: str = "csv") -> Path:
@@ -176,20 +258,31 @@ def write_text(path: str | os.PathLike[str], text: str, flag: str, kind: str = "
     return write_output(path, flag, lambda handle: handle.write(text.encode()), kind)
 
 
-def stream_text(
-    path: str | os.PathLike[str], chunks: Iterable[str], flag: str, kind: str = "csv"
-) -> Path:
-    """Write the texts ``chunks`` (UTF-8) to ``path`` as they are made, one at a time, so
-    that memory holds one chunk however long the file; atomically all the same: they go
-    into the temporary file, which replaces the target only after the last one. A failure
-    midway, in writing a chunk or in making one, leaves the old file as it was."""
+def streamed(
+    chunks: Iterable[str], digest: hashlib._Hash | None = None
+) -> Callable[[IO[bytes]], None]:
+    """A writer of the texts ``chunks`` (UTF-8), one at a time as they are made, so that
+    memory holds one chunk however long the file; ``digest`` (hashlib) is fed the bytes."""
 
     def write(handle: IO[bytes]) -> None:
         for chunk in chunks:
             fault_point("chunk")
-            handle.write(chunk.encode())
+            data = chunk.encode()
+            if digest is not None:
+                digest.update(data)
+            handle.write(data)
 
-    return write_output(path, flag, write, kind)
+    return write
+
+
+def stream_text(
+    path: str | os.PathLike[str], chunks: Iterable[str], flag: str, kind: str = "csv"
+) -> Path:
+    """Write the texts ``chunks`` (UTF-8) to ``path`` as they are made (:func:`streamed`);
+    atomically all the same: they go into the temporary file, which replaces the target
+    only after the last one. A failure midway, in writing a chunk or in making one,
+    leaves the old file as it was."""
+    return write_output(path, flag, streamed(chunks), kind)
 
 
 def pid_alive(pid: int) -> bool:

@@ -23,6 +23,7 @@ from ..bodies import THICKNESS, Plate
 from ..errors import ParameterError, PlateFileError
 from ..parameters import Parameter
 from ..registry import PluginRegistry, default_registry
+from ..untrusted import described, load_json_file, printable
 from .output import write_text
 
 FORMAT = "plateimpact-plate-1"
@@ -64,10 +65,10 @@ def plate_from_dict(
     """A :class:`Plate` from a plate-file object; :class:`PlateFileError` names ``source``
     and the key."""
     if not isinstance(data, dict):
-        raise PlateFileError(f"{source}: expected a JSON object, got {type(data).__name__}")
+        raise PlateFileError(f"{source}: expected a JSON object, got {described(data)}")
     if data.get("format") != FORMAT:
         raise PlateFileError(
-            f"{source}: not a plateimpact plate file (format {data.get('format')!r}, "
+            f"{source}: not a plateimpact plate file (format {data.get('format')!r:.60}, "
             f"expected {FORMAT!r})"
         )
     declarations = _declarations(registry)
@@ -77,7 +78,9 @@ def plate_from_dict(
             f"{source}: missing key{'s' * (len(missing) > 1)} {', '.join(missing)}"
         )
     if not isinstance(data["material"], str):
-        raise PlateFileError(f"{source}: material must be a string, got {data['material']!r}")
+        raise PlateFileError(
+            f"{source}: material must be a string, got {described(data['material'])}"
+        )
     values = {}
     for key, value in data.items():
         if key in RESERVED:
@@ -85,9 +88,12 @@ def plate_from_dict(
         declared = declarations.get(key)
         if declared is None:
             known = ", ".join(sorted(declarations))
-            raise PlateFileError(f"{source}: unknown key {key!r} (plate keys: {known})")
+            raise PlateFileError(f"{source}: unknown key {key!r:.60} (plate keys: {known})")
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise PlateFileError(f"{source}: {key} must be a number, got {value!r}")
+            raise PlateFileError(
+                f"{source}: {key}: must be a number {declared.describe_range()}, got "
+                f"{described(value)}"
+            )
         values[declared.name] = value * declared.scale
         try:
             if declared is not THICKNESS:
@@ -104,16 +110,10 @@ def plate_from_dict(
 
 def load_plate_file(path: str | os.PathLike[str], registry: PluginRegistry | None = None) -> Plate:
     """The plate in a plate file (JSON; see the module's description)."""
-    source = os.fspath(path)
-    try:
-        with open(source, encoding="utf-8-sig") as handle:  # a BOM is allowed
-            data = json.load(handle)
-    except OSError as exc:
-        raise PlateFileError(f"{source}: cannot read: {exc.strerror}") from None
-    except (ValueError, UnicodeDecodeError) as exc:  # JSONDecodeError is a ValueError
-        reason = str(exc).splitlines()[0]
-        raise PlateFileError(f"{source}: not valid JSON: {reason}") from None
-    return plate_from_dict(data, source, registry)
+    # bounded (nesting, integer digits, size), a duplicate key refused (never the last
+    # silently winning); a BOM is allowed
+    data = load_json_file(path, PlateFileError)
+    return plate_from_dict(data, printable(os.fspath(path), 200), registry)
 
 
 def plate_file_text(

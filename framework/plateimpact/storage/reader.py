@@ -14,13 +14,13 @@ import numpy as np
 
 from ..errors import ArchiveError, PlateImpactError
 from ..ragged import Ragged
+from ..untrusted import printable
 from .append import FORMAT, FORMAT_VERSION, READABLE_VERSIONS
 from .confined import SLACK, Opened, check_lengths, open_regular, shown_version
 from .contained import check_once, data_file, index_link_allowed, open_hdf5
 from .data_files import data_directory
 from .hdf5 import SEAL, digest, plain_attributes
 from .netcdf import POINT, SAMPLE
-from .untrusted import printable
 
 
 class ArchiveFiles:

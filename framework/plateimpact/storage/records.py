@@ -20,10 +20,10 @@ import h5py
 import numpy as np
 
 from ..errors import ArchiveError, ParameterError
+from ..untrusted import printable
 from .append import append_with
 from .data_files import DataFiles
 from .hdf5 import seal, write_dataset
-from .untrusted import printable
 
 #: The top-level group of the stored records; a study may not take its name.
 LIMITS = "limits"

@@ -17,10 +17,10 @@ import attrs
 
 from ..errors import ArchiveError, ParameterError
 from ..registry import PluginRegistry
+from ..untrusted import load_json, printable
 from ..variant import Variant
 from .append import RunExistsError, StudyDefinition, check_same_scenes
 from .code_provenance import changes, plugins_record
-from .untrusted import load_json, printable
 
 #: How a caller of the Python API proceeds past a stale run.
 API_ADVICE = "overwrite=True replaces it, run_names stores the new run under another name"

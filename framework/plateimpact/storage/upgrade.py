@@ -26,6 +26,7 @@ import h5py
 
 from ..errors import ArchiveError
 from ..registry import default_registry
+from ..untrusted import printable
 from . import stored_attributes as typed
 from .append import FORMAT, FORMAT_VERSION, add_run
 from .archive import WAIT, Archive
@@ -34,7 +35,6 @@ from .data_files import DataFiles, encoded, remove_orphans
 from .lock import locked
 from .output import unwritable
 from .records import LIMITS
-from .untrusted import printable
 
 
 def fault_point(stage: str) -> None:

@@ -10,12 +10,12 @@ import stat
 from pathlib import Path
 
 from ..errors import ArchiveError
+from ..untrusted import printable
 from . import confined, records
 from .append import FORMAT_VERSION
 from .confined import check_lengths, shown_version
 from .output import TEMPORARY_EXTRA, unwritable
 from .reader import ArchiveFiles
-from .untrusted import printable
 
 
 def check_writable(archive: ArchiveFiles, study: str | None = None) -> None:

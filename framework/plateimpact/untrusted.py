@@ -16,9 +16,11 @@ shot file, a P* table) may come from a colleague's machine or a hostile one. Two
 from __future__ import annotations
 
 import json
+import os
+from collections.abc import Callable
 from typing import Any
 
-from ..errors import PlateImpactError
+from .errors import PlateImpactError
 
 #: Deepest nesting of arrays and objects accepted. Every format plateimpact reads nests
 #: at most 4 deep (an inputs record's model settings holding a P* table's rows).
@@ -53,16 +55,26 @@ def _too_deep(text: str, limit: int) -> bool:
     return False
 
 
+#: What makes the caller's error from a one-line message: an error class taking the
+#: message alone, or a function (``lambda m: ParameterError("variant", m)``).
+ErrorFactory = Callable[[str], PlateImpactError]
+
+
 def load_json(
     text: str | bytes,
     what: str,
-    error: type[PlateImpactError] = PlateImpactError,
+    error: ErrorFactory = PlateImpactError,
     *,
     max_bytes: int = MAX_BYTES,
+    text_if_not_json: bool = False,
 ) -> Any:
     """The JSON value in ``text``, read from ``what`` (named in messages: a file, an
     attribute); any malformed, oversized, too deeply nested, duplicate-keyed or NaN
-    content raises ``error`` with one line."""
+    content raises ``error`` with one line.
+
+    ``text_if_not_json``: for a value that may be JSON or plain text (``--set
+    integrator.method=RK23``): text that is no JSON at all, and does not open an array
+    or object, is returned as it is; JSON beyond the bounds is still refused."""
     if isinstance(text, bytes | bytearray):
         if len(text) > max_bytes:
             raise error(f"{what}: {len(text):,} bytes of JSON, more than the {max_bytes:,} read")
@@ -75,21 +87,26 @@ def load_json(
     if _too_deep(text, MAX_DEPTH):
         raise error(f"{what}: JSON nested more than {MAX_DEPTH} deep")
 
+    def too_long(digits: int, key: str | None) -> PlateImpactError:
+        where = f"{printable(key, 80)}: " if key is not None else ""
+        return error(
+            f"{what}: {where}an integer of {digits} digits (at most {MAX_INTEGER_DIGITS} are read)"
+        )
+
     def pairs(items: list[tuple[str, Any]]) -> dict[str, Any]:
         out: dict[str, Any] = {}
         for key, value in items:
             if key in out:
                 raise error(f"{what}: key {printable(key)!r} appears twice")
+            overlong = _overlong(value)
+            if overlong is not None:  # named by its key: the reader's message would
+                raise too_long(overlong.digits, key)
             out[key] = value
         return out
 
-    def integer(literal: str) -> int:
-        if len(literal.lstrip("-")) > MAX_INTEGER_DIGITS:
-            raise error(
-                f"{what}: an integer of {len(literal.lstrip('-'))} digits (at most "
-                f"{MAX_INTEGER_DIGITS} are read)"
-            )
-        return int(literal)
+    def integer(literal: str) -> int | _Overlong:
+        digits = len(literal.lstrip("-"))
+        return _Overlong(digits) if digits > MAX_INTEGER_DIGITS else int(literal)
 
     def constant(name: str) -> float:
         if name == "NaN":
@@ -97,14 +114,86 @@ def load_json(
         return float(name)  # Infinity, -Infinity
 
     try:
-        return json.loads(text, object_pairs_hook=pairs, parse_int=integer, parse_constant=constant)
+        value = json.loads(
+            text, object_pairs_hook=pairs, parse_int=integer, parse_constant=constant
+        )
     except ValueError as exc:  # JSONDecodeError is one
         if isinstance(exc, PlateImpactError):
             raise
+        if text_if_not_json and isinstance(exc, json.JSONDecodeError):
+            if text.lstrip()[:1] not in ("[", "{"):
+                return text
         reason = str(exc).splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise error(f"{what}: not valid JSON: {printable(reason)}") from None
     except RecursionError:  # belt and braces: _too_deep should have caught it
         raise error(f"{what}: JSON nested too deeply") from None
+    overlong = _overlong(value)  # outside any object: the value itself, or an array's
+    if overlong is not None:
+        raise too_long(overlong.digits, None)
+    return value
+
+
+def load_json_file(
+    path: str | os.PathLike[str],
+    error: ErrorFactory = PlateImpactError,
+    *,
+    max_bytes: int = MAX_BYTES,
+) -> Any:
+    """The JSON value in the file at ``path``, as :func:`load_json` reads it (at most
+    ``max_bytes`` are read, never the whole of a huge file); a file that cannot be read
+    is ``error`` too, naming it (printable, cut to 200 characters)."""
+    what = printable(os.fspath(path), 200)
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(max_bytes + 1)
+    except OSError as exc:
+        raise error(f"{what}: cannot read: {exc.strerror or type(exc).__name__}") from None
+    except ValueError as exc:  # a NUL in the path
+        raise error(f"{what}: cannot read: {exc}") from None
+    return load_json(data, what, error, max_bytes=max_bytes)
+
+
+class _Overlong:
+    """An integer literal of more digits than are read, until its key is known."""
+
+    def __init__(self, digits: int) -> None:
+        self.digits = digits
+
+
+def _overlong(value: Any) -> _Overlong | None:
+    """The first over-long integer in ``value`` or in its arrays (objects were checked
+    when they were made), depth-first; bounded by :data:`MAX_DEPTH`."""
+    if isinstance(value, _Overlong):
+        return value
+    if isinstance(value, list):
+        for item in value:
+            found = _overlong(item)
+            if found is not None:
+                return found
+    return None
+
+
+def quoted(value: object, limit: int = 60) -> str:
+    """A value read from a file, for a message: its JSON, inert, cut to ``limit``."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return printable(text, limit)
+
+
+def described(value: object) -> str:
+    """What a value read from a file is, for a message: ``true``, ``null``, ``the string
+    "5"``, ``an array``, ``an object``, or the number (never the whole of a large one)."""
+    if isinstance(value, bool) or value is None:
+        return json.dumps(value)
+    if isinstance(value, str):
+        return f"the string {quoted(value)}"
+    if isinstance(value, list):
+        return f"an array of {len(value)}"
+    if isinstance(value, dict):
+        return "an object"
+    return quoted(value)
 
 
 def printable(text: object, limit: int | None = None) -> str:

@@ -1,0 +1,120 @@
+"""Standard output that cannot take what a command prints: a full device (``> /dev/full``,
+with Python's output buffered or not) or closed (``>&-``). Every command prints one line,
+``plateimpact: error: standard output ...``, and exits with code 2: never an internal
+error, a traceback, or Python's "Exception ignored" at exit (code 120).
+
+Each case runs in a child forked from one interpreter that has imported plateimpact
+(a subprocess per case would spend most of its time importing); the child sets up its
+standard output, then exits through ``sys.exit(main(...))`` as the ``plateimpact`` script
+does, so that the interpreter's own flush at exit is part of what is checked."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+SHOTS = Path(__file__).resolve().parents[1] / "studies" / "data"
+
+#: The child: fd 1 -> /dev/full (buffered or line by line) or closed, then main.
+DRIVER = textwrap.dedent(
+    """
+    import io, json, os, sys
+    from plateimpact.cli import build_parser, main
+    # what the commands import when they need it, imported once before forking
+    import plateimpact.export, plateimpact.limits.figures, plateimpact.plotting
+    import plateimpact.experiment.figure, plateimpact.v50.figure
+    build_parser()
+    cases = json.loads(sys.argv[1])
+    found = []
+    for argv, mode in cases:
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            os.close(read)
+            os.dup2(write, 2)
+            sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), write_through=True)
+            if mode == "closed":
+                os.close(1)
+                sys.stdout = None
+            else:
+                full = os.open("/dev/full", os.O_WRONLY)
+                os.dup2(full, 1)
+                if mode == "unbuffered":  # as python -u or PYTHONUNBUFFERED=1 make it
+                    raw = open(1, "wb", buffering=0, closefd=False)
+                    sys.stdout = io.TextIOWrapper(raw, write_through=True)
+                else:  # a file: block-buffered, flushed at exit
+                    sys.stdout = open(1, "w", closefd=False)
+            sys.exit(main(argv))  # as the console script: the interpreter exits here
+        os.close(write)
+        with os.fdopen(read, "rb") as pipe:
+            err = pipe.read().decode(errors="replace")
+        _, status = os.waitpid(pid, 0)
+        found.append([argv, mode, os.waitstatus_to_exitcode(status), err])
+    print(json.dumps(found))
+    """
+)
+
+
+def run_cases(cases: list[tuple[list[str], str]]) -> list[tuple[list[str], str, int, str]]:
+    done = subprocess.run(
+        [sys.executable, "-c", DRIVER, json.dumps(cases)], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    return [tuple(case) for case in json.loads(done.stdout)]
+
+
+def commands(archive: Path, tmp: Path) -> list[list[str]]:
+    """Every command that prints, on small inputs."""
+    preset = ["--preset", "2024-T3/3.18"]
+    few_shots = tmp / "shots.csv"  # validate's work is the shots': a few are enough
+    few_shots.write_text(
+        "impact_speed_m_s,impact_obliquity_deg,perforated\n300,45,0\n400,45,0\n600,45,1\n"
+    )
+    scene = [*preset, "--speed", "500", "--obliquity", "45"]
+    return [
+        ["--version"],
+        ["--help"],
+        ["run", "--help"],
+        ["presets"],
+        ["presets", "--json"],
+        ["plugins"],
+        ["plugins", "--details"],
+        ["run", *scene],
+        ["run", *scene, "--json"],
+        ["crater", *scene],
+        ["sweep", *preset, "--speeds", "300,600", "--obliquities", "30"],
+        ["sweep", *preset, "--speeds", "300,600", "--obliquities", "30", "--csv",
+         str(tmp / "s.csv")],
+        ["limits", *preset, "--obliquities", "45", "--tolerance", "5"],
+        ["map", *preset, "--speeds", "300:900:3", "--obliquities", "0,45", "--tolerance", "5",
+         "--png", str(tmp / "m.png"), "--dpi", "50"],
+        ["calibrate", str(SHOTS / "shots_2024T3_3.18mm.csv"), *preset],
+        ["validate", str(few_shots), "--preset", "SAE1010/1.47"],
+        ["v50", str(SHOTS / "gonogo_SAE1010_1.47mm.csv"), "--by-obliquity", "--bootstrap", "0"],
+        ["show", str(archive)],
+        ["compare", str(archive), "2024-T3_3.18mm/plugging", "2024-T3_3.18mm/large-pstar"],
+        ["compare", str(archive), "limits/map_2024-T3_3.18", "limits/map_2024-T3_6.35"],
+        ["export", str(archive), "--run", "2024-T3_1.27mm/plugging", "--to", str(tmp / "e.csv")],
+    ]  # fmt: skip
+
+
+def test_every_command_on_a_full_or_closed_standard_output_is_one_line(quick_report, tmp_path):
+    every = commands(quick_report / "report.h5", tmp_path)
+    cheap = [argv for argv in every if argv[0] in ("--version", "--help", "presets", "plugins")]
+    cases = [(argv, "buffered") for argv in every]
+    cases += [(argv, "unbuffered") for argv in [*cheap, every[7], every[8]]]
+    cases += [(argv, "closed") for argv in every]
+    for argv, mode, code, err in run_cases(cases):
+        assert code == 2, (argv, mode, code, err)
+        assert err.count("\n") == 1 and err.startswith("plateimpact: error: standard output"), (
+            argv,
+            mode,
+            err,
+        )
+        if mode == "closed":  # refused before any work
+            assert "is closed" in err
+        else:
+            assert "No space left on device" in err
