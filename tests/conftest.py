@@ -1,6 +1,9 @@
 from __future__ import annotations
 
 import importlib
+import importlib.util
+import os
+import sys
 import types
 from pathlib import Path
 
@@ -12,6 +15,33 @@ from plateimpact import presets
 
 #: A third-party plug-in package, usable without installing it (its .dist-info is beside it).
 THIRD_PARTY = Path(__file__).resolve().parent / "third_party"
+#: PLATEIMPACT_TEST_TIME_SCALE=0.01 python -m pytest: every wall-clock limit the package
+#: has by default scaled by 0.01, here and in every Python process the tests start
+#: (time_scale/sitecustomize.py, which they import at start-up from PYTHONPATH).
+TIME_SCALE = Path(__file__).resolve().parent / "time_scale"
+
+
+def _scale_time_limits() -> float:
+    spec = importlib.util.spec_from_file_location(
+        "plateimpact_test_time_scale", TIME_SCALE / "sitecustomize.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.install()
+    if module.SCALE != 1.0:
+        os.environ["PYTHONPATH"] = os.pathsep.join(
+            [str(TIME_SCALE), *filter(None, [os.environ.get("PYTHONPATH")])]
+        )
+        sys.path.append(str(TIME_SCALE))  # for tests that pass sys.path on to children
+    return module.SCALE
+
+
+SCALE = _scale_time_limits()
+
+
+def pytest_report_header() -> str:
+    return f"plateimpact time limits scaled by {SCALE:g} (PLATEIMPACT_TEST_TIME_SCALE)"
 
 
 @pytest.fixture(scope="session")
@@ -101,10 +131,9 @@ def sweep(
 
 # Hypothesis profiles: "ci" (the default: few examples, derandomized so CI is
 # reproducible) and "stress" (HYPOTHESIS_PROFILE=stress python -m pytest
-# tests/test_properties.py: many random examples).
+# tests/test_properties.py: many random examples). No deadline: a test's outcome never
+# depends on how fast the machine is.
 try:
-    import os
-
     from hypothesis import HealthCheck, settings
 
     settings.register_profile(

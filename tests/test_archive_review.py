@@ -17,6 +17,13 @@ from test_output_files import assert_one_line, run_cli
 import plateimpact as pi
 
 FORMAT1 = Path(__file__).parent / "data" / "format1.h5"
+#: How far a rerun on this machine may be from values another machine stored, in each
+#: column's scale (Vs, 1 rad, Rs, Rs/Vs). Bit for bit holds only on one machine: another
+#: libm, numpy or BLAS rounds force evaluations differently in the last bits, which can
+#: change which steps are accepted and so move a result by up to the integrator's error.
+#: dopri5 at its default rtol 1e-8 is within 1.7e-7 Vs and 1.2e-7 rad of the reference on
+#: the benchmark set (README), so two runs are within twice that: 1e-6 leaves room.
+RECOMPUTED = 1e-6
 SPEEDS = np.array([250.0, 600.0, 1000.0, 1400.0])
 OBLIQUITIES = [0.0, 45.0, 70.0]
 
@@ -157,6 +164,27 @@ def test_reproduce_twice_on_the_command_line(tmp_path, monkeypatch):
         assert_one_line(code, err, "--as", "printable tag")
 
 
+def assert_recomputed(rerun: pi.BatchResult, stored: pi.BatchResult, scenes: pi.SceneBatch):
+    """``rerun`` is ``stored`` computed again, here: the same outcomes and failures, every
+    value within RECOMPUTED of its scale, and the same crater depths."""
+    np.testing.assert_array_equal(rerun.outcome, stored.outcome)
+    np.testing.assert_array_equal(rerun.plate_failed, stored.plate_failed)
+    radius, speed = scenes.radius, scenes.impact_speed
+    scales = {"exit_speed": speed, "exit_obliquity": 1.0, "contact_time": radius / speed,
+              "max_penetration": radius, "failure_time": radius / speed,
+              "failure_penetration": radius, "failure_lateral": radius}  # fmt: skip
+    assert set(scales) | {"outcome", "plate_failed"} == set(stored.columns)
+    for name, scale in scales.items():
+        new, old = rerun.columns[name], stored.columns[name]
+        np.testing.assert_array_equal(np.isnan(new), np.isnan(old), err_msg=name)
+        gap = np.nan_to_num(np.abs(new - old)) / scale
+        assert np.all(gap <= RECOMPUTED), (name, gap.max())
+    assert rerun.craters is not None and stored.craters is not None
+    deepest = [[craters.row(i)["depth"].max() for i in range(scenes.size)]
+               for craters in (rerun.craters, stored.craters)]  # fmt: skip
+    assert np.all(np.abs(np.subtract(*deepest)) <= RECOMPUTED * radius)
+
+
 def test_a_format_1_archive_is_read_refused_for_appends_and_upgraded(tmp_path):
     path = tmp_path / "old.h5"
     shutil.copy(FORMAT1, path)
@@ -169,7 +197,9 @@ def test_a_format_1_archive_is_read_refused_for_appends_and_upgraded(tmp_path):
     study = pi.Study.from_archive(path)
     rerun = pi.Study.grid("v1", ["2024-T3/3.18"], [0, 60], np.array([300.0, 1100.0]),
                           pi.Variant("hinge", failure="hinge")).run(craters=True)  # fmt: skip
-    assert_same(rerun["hinge"], hinge)  # an independent rerun of the stored study
+    # An independent rerun of the stored study, on this machine: within a tolerance of
+    # what another machine stored (stored values are compared bit for bit below).
+    assert_recomputed(rerun["hinge"], hinge, study.scenes)
     assert study.scenes.size == 4 and old.limits_names() == ["l"]
     before = path.read_bytes()
     with pytest.raises(pi.ArchiveError, match="plateimpact upgrade"):

@@ -3,6 +3,7 @@ injected deterministically at each stage of an append (storage.append.fault_poin
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import stat
@@ -145,8 +146,9 @@ import numpy as np
 import plateimpact as pi
 study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
 result = study.run()["v"]
-for k in range(5):
-    pi.Archive(sys.argv[1]).append_run(study, pi.Variant(f"p{sys.argv[2]}r{k}"), result, {"n": k})
+for k in range(5):  # waiting as long as it takes: no clock decides where a run goes
+    archive = pi.Archive(sys.argv[1], wait=float("inf"))
+    archive.append_run(study, pi.Variant(f"p{sys.argv[2]}r{k}"), result, {"n": k})
 """
 
 
@@ -165,8 +167,8 @@ def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
     def appender(t: int) -> None:
         try:
             for k in range(5):
-                target = link if t % 2 else path
-                pi.Archive(target).append_run(study, pi.Variant(f"t{t}r{k}"), tiny_result, {"n": k})
+                archive = pi.Archive(link if t % 2 else path, wait=math.inf)
+                archive.append_run(study, pi.Variant(f"t{t}r{k}"), tiny_result, {"n": k})
         except BaseException as exc:  # noqa: BLE001 (reported below)
             errors.append(exc)
 
@@ -185,6 +187,12 @@ def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
             pi.Archive(path).results(run).exit_speed, tiny_result.exit_speed
         )
     assert link.is_symlink() and debris(tmp_path) == []
+
+
+@pytest.mark.parametrize("wait", [-1.0, math.nan, "300", None, True])
+def test_a_wait_that_is_no_number_of_seconds_is_refused(tmp_path, wait):
+    with pytest.raises(pi.ParameterError, match=r"wait must be a number of seconds >= 0"):
+        pi.Archive(tmp_path / "a.h5", wait=wait)
 
 
 def test_an_archive_and_an_output_keep_their_owner(tmp_path):

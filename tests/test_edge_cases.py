@@ -15,7 +15,9 @@ from plateimpact.units import deg
 SPHERE = presets.DEFAULT_SPHERE
 INTEGRATORS = {
     "dopri5": {},
-    "segment": {"step": 3e-4},
+    # The default step: grazing exits agree with 3e-4's to 2e-4 of their values (the
+    # claims below hold to 5%), and θ = 0 against 1e-12 is exact at any step.
+    "segment": {"step": 1e-3},
     "solve_ivp": {"rtol": 1e-10},
 }
 
@@ -114,10 +116,10 @@ def test_the_direction_at_rest_converges_for_every_integrator():
     assert 30 * deg < reference.exit_obliquity < 150 * deg  # still turning at rest
     adaptive = simulation("dopri5").run(scene).exit_obliquity
     assert abs(adaptive - reference.exit_obliquity) < 1e-4 * deg
-    steps = [1e-3, 1e-4]
+    steps = [4e-3, 4e-4]  # a decade inside the first-order range (1e-4 costs 4x more)
     errors = [
         abs(simulation("segment", step=s).run(scene).exit_obliquity - reference.exit_obliquity)
         for s in steps
     ]
     assert errors[1] < 0.2 * errors[0]  # first order: ~10x per decade of step
-    assert errors[1] < 1e-3 * deg * 10
+    assert errors[1] < 100 * deg * steps[1]  # 0.01 deg at 1e-4

@@ -22,8 +22,13 @@ def grid(plate, obliquities, speeds=SPEEDS):
     )
 
 
-def run(batch, failure, integrator="segment", **settings):
-    integrator_settings = {"step": 2e-3} if integrator == "segment" else {}
+#: The segment step of the tests whose claims hold at any step (identities to the last
+#: bit, the finger making a difference): the coarsest the integrator allows but one.
+ANY_STEP = 1e-2
+
+
+def run(batch, failure, integrator="segment", step=2e-3, **settings):
+    integrator_settings = {"step": step} if integrator == "segment" else {}
     simulation = pi.Simulation.from_names(
         failure=failure,
         failure_settings=settings,
@@ -41,7 +46,8 @@ def assert_identical(a, b):
 @pytest.mark.parametrize("plate", ["SAE1010/1.47", "2024-T3/3.18"])
 def test_hinge_without_finger_is_plugging_to_the_last_bit(plate):
     batch = grid(presets.plate(plate), [0, 30, 45, 60])
-    assert_identical(run(batch, "hinge", finger_area_scale=0.0), run(batch, "plugging"))
+    hinge = run(batch, "hinge", step=ANY_STEP, finger_area_scale=0.0)
+    assert_identical(hinge, run(batch, "plugging", step=ANY_STEP))
 
 
 def test_hinge_without_finger_is_plugging_to_tolerance_under_error_control():
@@ -85,7 +91,7 @@ def test_hinge_finger_at_normal_incidence_has_no_lift(integrator):
 
 def test_the_finger_changes_the_result():
     batch = grid(STEEL, [45, 60])
-    hinge, plugging = run(batch, "hinge"), run(batch, "plugging")
+    hinge, plugging = run(batch, "hinge", step=ANY_STEP), run(batch, "plugging", step=ANY_STEP)
     failed = plugging.plate_failed
     assert np.any(hinge.exit_speed[failed] != plugging.exit_speed[failed])
 
@@ -96,8 +102,8 @@ def test_variable_pstar_with_one_constant_is_constant_pstar_to_the_last_bit(psta
     plate = attrs.evolve(STEEL, critical_penetration=pstar_mm * mm)
     batch = grid(plate, [0, 45, 60])
     table = PstarTable.constant(pstar_mm * mm)
-    variable = run(batch, "variable-pstar", integrator=integrator, table=table)
-    assert_identical(variable, run(batch, "plugging", integrator=integrator))
+    variable = run(batch, "variable-pstar", integrator=integrator, step=ANY_STEP, table=table)
+    assert_identical(variable, run(batch, "plugging", integrator=integrator, step=ANY_STEP))
 
 
 class TestSAE1010Table:

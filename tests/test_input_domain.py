@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import plateimpact as pi
-from plateimpact import calibration, presets
+from plateimpact import calibration, driver, presets
 from plateimpact.calibration.start import log_domain
 from plateimpact.cli import main
 
@@ -138,11 +138,66 @@ def test_calibration_shots_that_fix_no_fit_are_one_line(rows, named, tmp_path, c
 # -- the work bounds -------------------------------------------------------------------
 
 
-def test_the_wall_time_bound_ends_a_run_with_one_line_naming_its_flag(capsys):
-    # A budget no scene can meet: the bound fires at the first pass, whatever the machine.
-    err = one_error_line([*RUN, "--set", "integrator.max_seconds=1e-12"], capsys)
-    assert "dopri5: 1 scene(s) unfinished after max_seconds=1e-12 s of wall time" in err
+class Clock:
+    """A fake ``time`` module for the driver: each read of the clock advances it by
+    ``seconds`` (a machine as slow as we like, deterministically); ``reads`` counts them."""
+
+    def __init__(self, seconds: float) -> None:
+        self.seconds, self.now, self.reads = seconds, 0.0, 0
+
+    def perf_counter(self) -> float:
+        self.reads += 1
+        self.now += self.seconds
+        return self.now
+
+
+def test_where_a_scene_ends_never_depends_on_the_clock(monkeypatch, capsys):
+    """By default no wall-time bound is armed: on a machine so slow that every pass of
+    the step loop takes an hour, results are bit for bit the same and a scene that needs
+    more work than max_steps ends with the same line naming max_steps."""
+    batch = pi.SceneBatch.grid(SPHERE, PLATE, [300.0, 640.0, 1200.0], np.radians([0.0, 60.0]))
+    integrators = {"dopri5": {}, "segment": {"step": 1e-2}, "solve_ivp": {"rtol": 1e-8}}
+    quick = {n: pi.Simulation.from_names(integrator=n, integrator_settings=s)
+             for n, s in integrators.items()}  # fmt: skip
+    expected = {n: simulation.run_batch(batch) for n, simulation in quick.items()}
+    bounded = [*RUN, "--set", "integrator.max_steps=7"]
+    fast = one_error_line(bounded, capsys)
+    slow = Clock(3600.0)
+    monkeypatch.setattr(driver, "time", slow)
+    for name, simulation in quick.items():
+        result = simulation.run_batch(batch)
+        for column, values in expected[name].columns.items():
+            np.testing.assert_array_equal(result.columns[column], values, err_msg=column)
+    assert one_error_line(bounded, capsys) == fast
+    assert "unfinished after max_steps=7 steps" in fast and slow.reads == 0
+    assert all(s.default == math.inf for s in [pi.MAX_SECONDS, *max_seconds_declarations()])
+
+
+def test_the_opt_in_wall_time_bound_ends_a_run_with_one_line_naming_its_flag(monkeypatch, capsys):
+    """max_seconds, when a user sets it, is charged per scene on the clock: with a clock
+    that advances 1 s a read it fires at the pass that takes a scene past the limit."""
+    clock = Clock(1.0)
+    monkeypatch.setattr(driver, "time", clock)
+    err = one_error_line([*RUN, "--set", "integrator.max_seconds=2.5"], capsys)
+    assert "dopri5: 1 scene(s) unfinished after max_seconds=2.5 s of wall time" in err
+    assert "after 2 steps" in err  # charged 1 s per pass: over 2.5 s at the 3rd
     assert "raise max_seconds (--set integrator.max_seconds=SECONDS)" in err
+    assert clock.reads == 4
+
+
+def test_a_sphere_sliding_on_a_plate_that_never_holds_it_is_refused_by_its_steps(capsys):
+    """The first slowest scene of docs/robustness.md: P* = 1 nm fails the plate at first
+    contact, and at 89.999 deg the sphere must slide about 2 Rs / cos(89.999 deg) =
+    1.1e5 Rs at nearly its impact speed before it is through. dopri5's steps are at most
+    0.5 Rs/Vs, so it needs more than 2e5 steps: the default bound ends it, by count."""
+    scene = ["run", "--preset", "2024-T3/3.18", "--speed", "10000", "--obliquity", "89.999",
+             "--pstar", "1e-6"]  # fmt: skip
+    err = one_error_line([*scene, "--set", "integrator.max_steps=400"], capsys)
+    progress = err.split("(first: scene 0, at ")[1].split(" after ")[0]
+    depth, speed, time = (float(part.split(" = ")[1].split()[0]) for part in progress.split(", "))
+    assert depth < 0.1 and speed == 1.0 and 0.9 * 200.0 < time <= 200.0  # <= 0.5 Rs/Vs a step
+    slide = 2.0 / math.cos(math.radians(89.999))
+    assert slide / 0.5 > pi.MAX_STEPS.default
 
 
 @pytest.mark.parametrize("integrator", ["dopri5", "segment", "solve_ivp"])
@@ -168,11 +223,22 @@ def test_every_builtin_integrator_declares_both_work_bounds():
     for name in registry.names("integrator"):
         settings = registry.get("integrator", name).setting_declarations()
         assert {"max_steps", "max_seconds"} <= set(settings), name
-        assert settings["max_seconds"].default == pi.MAX_SECONDS.default == 20.0
+        assert settings["max_seconds"].default == pi.MAX_SECONDS.default == math.inf
+    # An integrator that declares neither keeps the base class's: the same bounds.
+    assert (pi.Integrator.max_steps, pi.Integrator.max_seconds) == (pi.MAX_STEPS.default, math.inf)
 
 
-def test_the_wall_time_bound_in_the_api_is_an_integration_error():
-    simulation = pi.Simulation.from_names(integrator_settings={"max_seconds": 1e-12})
+def max_seconds_declarations() -> list[pi.Parameter]:
+    registry = pi.load_registry()
+    return [
+        registry.get("integrator", name).setting_declarations()["max_seconds"]
+        for name in registry.names("integrator")
+    ]
+
+
+def test_the_wall_time_bound_in_the_api_is_an_integration_error(monkeypatch):
+    monkeypatch.setattr(driver, "time", Clock(1.0))
+    simulation = pi.Simulation.from_names(integrator_settings={"max_seconds": 0.5})
     batch = pi.SceneBatch.grid(SPHERE, PLATE, [300.0, 600.0], [0.0])
     with pytest.raises(pi.IntegrationError, match=r"2 scene\(s\) unfinished after max_seconds"):
         simulation.run_batch(batch)

@@ -107,6 +107,25 @@ def test_an_editable_install_gives_its_checkouts_commit(tmp_path, install):
     assert provenance.source_commit(tmp_path / "repo" / "framework" / "plateimpact") == head
 
 
+def test_a_git_that_never_answers_leaves_the_commit_unknown_and_says_so(
+    tmp_path, install, monkeypatch
+):
+    """git gets provenance.GIT_TIMEOUT (a guard against a hung git, far above what a busy
+    machine's rev-parse takes); one that never answers is a warning, never a silent
+    "unknown". The fake git never answers however fast the machine: no timing decides."""
+    checkout(tmp_path / "src")
+    install(installed(tmp_path / "site", {"url": (tmp_path / "src").as_uri(), "dir_info": {}}))
+    hung = tmp_path / "bin" / "git"
+    hung.parent.mkdir()
+    hung.write_text("#!/bin/sh\nexec sleep 3600\n")
+    hung.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{hung.parent}{os.pathsep}{os.environ['PATH']}")
+    monkeypatch.setattr(provenance, "GIT_TIMEOUT", 0.5)
+    said = r"git gave no answer in .*src within 0.5 s; the source commit is recorded as unknown"
+    with pytest.warns(pi.PlateImpactWarning, match=said):
+        assert provenance.source_commit(tmp_path / "site" / "plateimpact") == "unknown"
+
+
 @pytest.mark.parametrize("source", ["index", "unpacked", "inside the enclosing repository"])
 def test_a_repository_enclosing_site_packages_is_never_asked(tmp_path, install, source):
     """site-packages inside a repository of its own (a project's .venv): git asked there
@@ -327,7 +346,7 @@ def test_show_prints_a_runs_inputs_and_provenance(tmp_path, capsys):
     assert main(["show", str(path)]) == 0
     out = capsys.readouterr().out
     assert "failure: hinge 1 (finger_area_scale 0.5, hinge_obliquity none)" in out
-    assert "rtol 1e-09" in out and "max_seconds 20 s" in out
+    assert "rtol 1e-09" in out and "max_seconds inf s, max_steps 20000" in out
     assert f"source commit {meta['git_commit']}" in out
     for name, version in meta["versions"].items():
         assert f"{name} {version}" in out

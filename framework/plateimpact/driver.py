@@ -9,6 +9,7 @@ recording, and dropping finished scenes. The integrator only steps
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -70,6 +71,22 @@ def _unfinished(
     )
 
 
+class _WallTime:
+    """The opt-in wall-time bound (``max_seconds``): each pass of the loop is charged in
+    equal shares to the scenes it advanced, so ``used`` is what each scene still running
+    has cost so far [s]."""
+
+    def __init__(self, running: int) -> None:
+        self.last, self.used, self.running = time.perf_counter(), 0.0, running
+
+    def charge(self, running: int) -> float:
+        """Charge the pass just ended; ``running``: the scenes the next one advances."""
+        now = time.perf_counter()
+        self.used += (now - self.last) / self.running
+        self.last, self.running = now, running
+        return self.used
+
+
 def _progress(y: np.ndarray, t: np.ndarray, batch: BoundBatch, stats: dict) -> str:
     """Where the first unfinished scene is, in its own scales (Rs, Vs, Rs/Vs)."""
     core = batch.core
@@ -83,9 +100,9 @@ def _progress(y: np.ndarray, t: np.ndarray, batch: BoundBatch, stats: dict) -> s
 def _integrate(
     model: ImpactModel, integrator: Integrator, batch: BoundBatch, recorder: ResultRecorder
 ) -> None:
-    # The wall-time bound: each pass of the loop is charged in equal shares to the scenes
-    # it advanced, so `used` is the time each scene still running has cost so far.
-    last, used, running = time.perf_counter(), 0.0, batch.size
+    # Where a scene ends is decided by counted work (max_steps) alone; the clock is read
+    # only when a user opted into a wall-time bound, which can end a run, never change it.
+    clock = _WallTime(batch.size) if math.isfinite(integrator.max_seconds) else None
     n = batch.size
     width = KINEMATIC_STATE + len(model.failure.state_names)
     scene = np.arange(n)
@@ -110,10 +127,7 @@ def _integrate(
     margins_now, known = np.empty((5, n)), np.zeros(n, bool)
 
     for _ in range(integrator.max_steps):
-        now = time.perf_counter()
-        used += (now - last) / running
-        last, running = now, scene.size
-        if used > integrator.max_seconds:
+        if clock is not None and clock.charge(scene.size) > integrator.max_seconds:
             limit = f"max_seconds={integrator.max_seconds:g} s of wall time"
             where = _progress(y, t, batch, stats)
             raise _unfinished(integrator, limit, "max_seconds", "SECONDS", scene, where)

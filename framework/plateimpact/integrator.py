@@ -9,6 +9,7 @@ one) and a dense output on which the driver locates events.
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from typing import ClassVar, NamedTuple
 
@@ -24,24 +25,33 @@ from .plugin import Plugin
 #: driver then uses instead of evaluating it again (branch prediction).
 StepperState = dict[str, np.ndarray]
 
+#: The work bound of every built-in integrator, counted (never timed), so that where a
+#: scene ends never depends on the machine's speed or load. 20,000 steps is at least 1e4
+#: Rs/Vs at dopri5's largest step (0.5 Rs/Vs; solve_ivp's longest_phase is the same 1e4):
+#: 23 times what the report's figures, maps and limits need (at most 859 steps, dopri5 at
+#: rtol 1e-8 to 1e-13), 1.7 times the longest scene of the property tests' domain (11,836:
+#: a = 3e7 N/m², b = 30 kg/m³, 5 km/s, intact), and for the segment method contacts of
+#: 160 Rs/Vs at its default step (the longest map scene: 145). A scene that needs more
+#: ends after 15-25 s of one core (docs/robustness.md, "work bounds").
 MAX_STEPS = Parameter(
     "max_steps",
     "give up (IntegrationError) when a scene has not finished after this many steps",
     kind=int,
     range=Range(1.0),
-    default=200_000,
+    default=20_000,
 )
-#: A scene's wall time is its share of the loop's: each step's time divided among the
-#: scenes still running. 20 s leaves a single-scene command (under 1 s to start, a few to
-#: write its outputs) inside 30 s, and is far above what an ordinary scene needs (500 m/s
-#: at 30° on 2024-T3/3.18: 0.05 s with dopri5 or solve_ivp, 4 s with segment at step 1e-4).
+#: An opt-in safety net only, off by default: a wall-time limit would make a scene's end
+#: depend on how fast and how busy the machine is. When set, it ends a run with an
+#: IntegrationError naming it; it never changes a result. A scene's wall time is its
+#: share of the loop's: each step's time divided among the scenes still running.
 MAX_SECONDS = Parameter(
     "max_seconds",
     "give up (IntegrationError) when a scene has used this much wall time (each step's "
-    "time shared among the scenes still running; inf: no limit)",
+    "time shared among the scenes still running; default inf: no limit, the step bound "
+    "alone ends a run)",
     "s",
     Range(0.0, low_open=True, allow_inf=True),
-    default=20.0,
+    default=math.inf,
 )
 # 1e-13 is the tightest tolerance the project uses (the work-precision reference): a few
 # hundred times the rounding of a double, below which steps shrink without gaining.
@@ -95,10 +105,11 @@ class Integrator(Plugin, ABC):
     :meth:`step_control` as needed.
     """
 
-    #: Give up after this many steps, or when a scene has used this much wall time [s]
-    #: (settings in the built-ins: :data:`MAX_STEPS`, :data:`MAX_SECONDS`).
-    max_steps: int = 200_000
-    max_seconds: float = 20.0
+    #: Give up after this many steps, or (opt-in: inf by default) when a scene has used
+    #: this much wall time [s] (settings in the built-ins: :data:`MAX_STEPS`,
+    #: :data:`MAX_SECONDS`).
+    max_steps: int = 20_000
+    max_seconds: float = math.inf
     #: Equally spaced samples per step, ends included, at which the driver looks for
     #: events and records the trajectory: more for long steps, 2 for very short ones.
     event_samples: ClassVar[int] = 5

@@ -28,8 +28,9 @@ STEP = Parameter(
     "step",
     "segment duration as a fraction of Rs/Vs, the time to travel one radius at impact "
     "speed (finest documented 1e-4)",
-    # 1e-5, the finest step tested, already takes 40 s on an ordinary scene (max_seconds
-    # ends it); finer steps only add rounding to a first-order method.
+    # 1e-5, the finest step tested: 500 m/s at 30 deg on 2024-T3/3.18 would need 54,000
+    # steps (40 s) there, and max_steps ends it; finer steps only add rounding to a
+    # first-order method.
     range=Range(1e-5, 0.1),
     default=1e-3,
     flag="--step",
@@ -91,7 +92,10 @@ class Segment(Integrator):
 
     The driver sees ``SEGMENTS`` segments as one step, sampled at every segment's end:
     the same segments, events and trajectory, with the driver's bookkeeping spread over
-    them (segments computed past an event are discarded); ``max_steps`` counts such steps.
+    them (segments computed past an event are discarded); ``max_steps`` counts such steps:
+    a contact of C Rs/Vs takes C / (8 ``step``) of them, so the default 20,000 covers 160
+    Rs/Vs at the default step (the longest of the presets' maps, 0-84 deg and 50-2000 m/s,
+    is 145) and 16 Rs/Vs at 1e-4 (docs/robustness.md, "work bounds").
     """
 
     name = "segment"
@@ -101,7 +105,7 @@ class Segment(Integrator):
     event_samples = SEGMENTS + 1
 
     step: float = STEP.field()
-    max_steps: int = attrs.evolve(MAX_STEPS, default=2_500_000).field()
+    max_steps: int = MAX_STEPS.field()
     max_seconds: float = MAX_SECONDS.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:

@@ -24,7 +24,7 @@ import h5py
 import numpy as np
 
 from ..batch import SceneBatch
-from ..errors import ArchiveError, PlateImpactError, UnknownNameError
+from ..errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
 from ..parameters import Parameter
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
 from ..untrusted import printable
@@ -67,12 +67,16 @@ class Archive(ArchiveFiles):
     Every failure to open, read or write (missing directory, not HDF5, another format
     version, checksum mismatch, missing data file, read-only, busy) raises
     :class:`ArchiveError` with a one-line message. ``wait``: how long an append waits
-    for another writer [s].
+    for another writer [s] (inf: as long as it takes).
     """
 
     def __init__(self, path: str | os.PathLike[str], *, wait: float = WAIT) -> None:
         super().__init__(path)
-        self.wait = wait
+        if isinstance(wait, bool) or not isinstance(wait, int | float) or not wait >= 0.0:
+            raise ParameterError(
+                "wait", f"wait must be a number of seconds >= 0 (inf: no limit), got {wait!r}"
+            )
+        self.wait = float(wait)
 
     # -- writing ---------------------------------------------------------------------
 

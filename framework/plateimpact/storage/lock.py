@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import math
 import os
 import socket
 import stat
@@ -33,6 +34,10 @@ from ..untrusted import printable
 
 #: How often a waiting writer looks again [s].
 POLL = 0.05
+#: What a busy archive's message says to wait longer. The wait decides only where a
+#: finished run is stored (the archive, or a side archive the message names), never its
+#: values.
+WAIT_SETTING = " (Archive(path, wait=SECONDS) waits longer; inf: as long as it takes)"
 
 _THREAD_LOCKS: dict[Path, threading.Lock] = {}
 _GUARD = threading.Lock()
@@ -96,15 +101,16 @@ def busy(lock_path: Path) -> bool:
 @contextlib.contextmanager
 def locked(path: Path, real: Path, lock_path: Path, wait: float) -> Iterator[None]:
     """Hold the write lock of the archive whose real path is ``real`` (``path`` as the
-    user named it, for messages), waiting up to ``wait`` seconds for another writer;
-    :class:`ArchiveBusyError` if it is still busy then."""
+    user named it, for messages), waiting up to ``wait`` seconds (inf: as long as it
+    takes) for another writer; :class:`ArchiveBusyError` if it is still busy then."""
     deadline = time.monotonic() + wait
     thread_lock = _thread_lock(real)
     if not thread_lock.acquire(blocking=False):
         _announce(path, "another thread of this process")
-        if not thread_lock.acquire(timeout=max(wait, 0.0)):
+        if not thread_lock.acquire(timeout=-1 if math.isinf(wait) else max(wait, 0.0)):
             raise ArchiveBusyError(
                 f"archive {path} stayed busy with another thread of this process for {wait:g} s"
+                f"{WAIT_SETTING}"
             )
     try:
         try:
@@ -126,7 +132,8 @@ def locked(path: Path, real: Path, lock_path: Path, wait: float) -> Iterator[Non
                 except BlockingIOError:
                     if time.monotonic() >= deadline:
                         raise ArchiveBusyError(
-                            f"archive {path} stayed busy ({holder(fd)} writing it) for {wait:g} s"
+                            f"archive {path} stayed busy ({holder(fd)} writing it) for "
+                            f"{wait:g} s{WAIT_SETTING}"
                         ) from None
                     if not announced:
                         _announce(path, holder(fd))

@@ -10,6 +10,7 @@ import platform
 import socket
 import subprocess
 import time
+import warnings
 from collections.abc import Mapping
 from importlib import metadata as importlib_metadata
 from pathlib import Path
@@ -18,6 +19,7 @@ from urllib.parse import urlparse
 from urllib.request import url2pathname
 
 from ..bodies import Plate, Sphere
+from ..errors import PlateImpactWarning
 from ..parameters import Parameter
 from ..simulation import Simulation
 from ..variant import Variant
@@ -36,6 +38,12 @@ PACKAGE_DIR = Path(__file__).resolve().parents[1]
 PACKAGE_IN_CHECKOUT = ("framework", "plateimpact")
 
 
+#: How long git may take to name a checkout's HEAD [s]: only a guard against a git that
+#: hangs (a dead network mount), far above the milliseconds ``rev-parse`` takes on a busy
+#: machine; when it fires, the commit is recorded as "unknown" and a warning says so.
+GIT_TIMEOUT = 60.0
+
+
 def _git(directory: Path, *args: str) -> list[str] | None:
     """git's output lines in ``directory``, or None if git cannot answer. GIT_DIR and its
     kin are dropped from the environment: they would point git at another repository."""
@@ -45,10 +53,18 @@ def _git(directory: Path, *args: str) -> list[str] | None:
             ["git", "-C", str(directory), *args],
             capture_output=True,
             text=True,
-            timeout=5,
+            timeout=GIT_TIMEOUT,
             check=True,
             env=environment,
         )
+    except subprocess.TimeoutExpired:
+        warnings.warn(
+            f"git gave no answer in {directory} within {GIT_TIMEOUT:g} s; the source commit "
+            "is recorded as unknown",
+            PlateImpactWarning,
+            stacklevel=2,
+        )
+        return None
     except (OSError, subprocess.SubprocessError):
         return None
     return out.stdout.split()
