@@ -346,7 +346,7 @@ def test_show_prints_a_runs_inputs_and_provenance(tmp_path, capsys):
     assert main(["show", str(path)]) == 0
     out = capsys.readouterr().out
     assert "failure: hinge 1 (finger_area_scale 0.5, hinge_obliquity none)" in out
-    assert "rtol 1e-09" in out and "max_seconds inf s, max_steps 20000" in out
+    assert "rtol 1e-09" in out and "max_seconds none, max_steps 20000" in out
     assert f"source commit {meta['git_commit']}" in out
     for name, version in meta["versions"].items():
         assert f"{name} {version}" in out

@@ -32,6 +32,6 @@ def test_a_process_the_tests_start_scales_every_limit_as_its_modules_load(tmp_pa
                    "PYTHONPATH": str(TIME_SCALE)}  # fmt: skip
     done = subprocess.run([sys.executable, "-c", SHOW], capture_output=True, text=True,
                           env=environment, cwd=tmp_path, check=True)  # fmt: skip
-    wait, delay, git, *max_seconds = json.loads(done.stdout)  # inf as Infinity
+    wait, delay, git, *max_seconds = json.loads(done.stdout)
     assert [wait, delay, git] == [0.25 * value for value in defaults]
-    assert max_seconds == [math.inf, math.inf]  # no wall-time bound by default: nothing to scale
+    assert max_seconds == [None, None]  # no wall-time bound by default: nothing to scale

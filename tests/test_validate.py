@@ -160,16 +160,15 @@ def test_agreement_and_errors_follow_their_weighted_closed_forms():
     assert own.exit_obliquity_rms == pytest.approx(2.0 * deg, rel=1e-9)
 
 
-def no_nan(constant: str) -> float:
-    assert constant != "NaN"
-    return float(constant)
+def no_constant(constant: str) -> float:
+    raise AssertionError(f"{constant} is not strict JSON")
 
 
 def test_go_no_go_shots_alone_give_null_errors_in_json():
     blind = shots_of(PLATE, go_no_go=1.0).take(np.arange(0, 48, 6))
     out = pi.validate(SIMULATION, SPHERE, PLATE, blind).to_json()
     text = json.dumps(out)
-    json.loads(text, parse_constant=no_nan)  # Infinity is the model's max_seconds
+    json.loads(text, parse_constant=no_constant)  # strict JSON: no NaN, no Infinity
     assert out["residual_speed_rms_m_s"] is None and out["residual_speed_bias_m_s"] is None
     assert out["exit_obliquity_rms_deg"] is None and out["outcome_agreement"] == 1.0
     assert '"perforated"' in text and out["shots"] == 8

@@ -102,7 +102,8 @@ def _integrate(
 ) -> None:
     # Where a scene ends is decided by counted work (max_steps) alone; the clock is read
     # only when a user opted into a wall-time bound, which can end a run, never change it.
-    clock = _WallTime(batch.size) if math.isfinite(integrator.max_seconds) else None
+    limit = integrator.max_seconds
+    clock = _WallTime(batch.size) if limit is not None and math.isfinite(limit) else None
     n = batch.size
     width = KINEMATIC_STATE + len(model.failure.state_names)
     scene = np.arange(n)
@@ -127,10 +128,10 @@ def _integrate(
     margins_now, known = np.empty((5, n)), np.zeros(n, bool)
 
     for _ in range(integrator.max_steps):
-        if clock is not None and clock.charge(scene.size) > integrator.max_seconds:
-            limit = f"max_seconds={integrator.max_seconds:g} s of wall time"
+        if clock is not None and limit is not None and clock.charge(scene.size) > limit:
             where = _progress(y, t, batch, stats)
-            raise _unfinished(integrator, limit, "max_seconds", "SECONDS", scene, where)
+            text = f"max_seconds={limit:g} s of wall time"
+            raise _unfinished(integrator, text, "max_seconds", "SECONDS", scene, where)
         stats["steps"] += 1
         step = integrator.advance(dynamics, t, y, sizes.propose(dynamics, y, state), state)
         ok = sizes.judge(step, y)
@@ -225,6 +226,6 @@ def _integrate(
             state = {key: values[..., keep] for key, values in state.items()}
             sizes.take(keep)
             dynamics = Dynamics(model, batch, failed, held, stats)
-    limit = f"max_steps={integrator.max_steps} steps"
     where = _progress(y, t, batch, stats)
-    raise _unfinished(integrator, limit, "max_steps", "N", scene, where)
+    text = f"max_steps={integrator.max_steps} steps"
+    raise _unfinished(integrator, text, "max_steps", "N", scene, where)

@@ -101,7 +101,7 @@ class EmbeddedRungeKutta(Integrator):
 
     rtol: float = RTOL.field()
     max_steps: int = MAX_STEPS.field()
-    max_seconds: float = MAX_SECONDS.field()
+    max_seconds: float | None = MAX_SECONDS.field()
     fixed_step: float | None = FIXED_STEP.field()
     branch_landing: bool = BRANCH_LANDING.field()
 

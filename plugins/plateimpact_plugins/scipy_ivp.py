@@ -85,7 +85,7 @@ class ScipyIVP(Integrator):
     method: str = METHOD.field()
     rtol: float = attrs.evolve(RTOL, default=1e-10).field()
     max_steps: int = MAX_STEPS.field()
-    max_seconds: float = MAX_SECONDS.field()
+    max_seconds: float | None = MAX_SECONDS.field()
     longest_phase: float = LONGEST_PHASE.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:

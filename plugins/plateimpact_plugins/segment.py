@@ -106,7 +106,7 @@ class Segment(Integrator):
 
     step: float = STEP.field()
     max_steps: int = MAX_STEPS.field()
-    max_seconds: float = MAX_SECONDS.field()
+    max_seconds: float | None = MAX_SECONDS.field()
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
         return self.SEGMENTS * self.step * dynamics.time_scale

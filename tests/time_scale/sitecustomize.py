@@ -8,7 +8,7 @@ PYTHONPATH, so that every Python process the tests start imports this file at st
 
 The limits (docs/robustness.md, "work bounds"): an archive's lock wait (``WAIT``, 300 s),
 the progress bar's delay (``DELAY``, 2 s), git's timeout (``GIT_TIMEOUT``, 60 s) and the
-integrators' ``max_seconds`` (inf by default: nothing to scale; a finite default would
+integrators' ``max_seconds`` (None by default, no limit: nothing to scale; a finite default would
 need scaling here, so it stops the run).
 """
 
@@ -42,7 +42,7 @@ def _provenance(module: ModuleType, scale: float) -> None:
 
 def _integrator(module: ModuleType, scale: float) -> None:
     defaults = (module.MAX_SECONDS.default, module.Integrator.max_seconds)
-    if not all(math.isinf(default) for default in defaults):
+    if any(default is not None for default in defaults):
         raise RuntimeError(f"max_seconds defaults {defaults}: scale them in {__file__}")
 
 
