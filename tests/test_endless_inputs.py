@@ -6,6 +6,8 @@ a time), never the whole of it."""
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -43,3 +45,49 @@ def test_a_shot_file_line_beyond_reason_is_one_line(tmp_path: Path):
     for argv in (["v50", str(path)], ["validate", str(path), "--preset", "2024-T3/3.18"]):
         code, _, err = run_cli(argv)
         assert_one_line(code, err, "line 2", "longer than")
+
+
+FIFO_FLAGS = {
+    "run --inputs": ["run", "--inputs", "{}"],
+    "--plate-file": ["run", "--plate-file", "{}", *SCENE],
+    "validate": ["validate", "{}", "--preset", "2024-T3/3.18"],
+    "v50": ["v50", "{}"],
+    "calibrate": ["calibrate", "{}", "--preset", "2024-T3/3.18"],
+    "--pstar-table": ["run", "--preset", "SAE1010/1.47", *SCENE, "--failure", "variable-pstar",
+                      "--pstar-table", "{}"],
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("flag", FIFO_FLAGS)
+def test_a_named_pipe_shipped_as_an_input_file_is_one_line_never_a_wait(tmp_path, flag):
+    """A tarball can hold a FIFO named like a shot or plate file; opening it for reading
+    would wait for a writer forever. It is refused before the open, in one line. (The
+    command runs in a child: were it to wait, the timeout, which a passing run never
+    comes near, turns the hang into a failure rather than a stuck suite.)"""
+    fifo = tmp_path / "shots.csv"
+    os.mkfifo(fifo)
+    argv = [arg.replace("{}", str(fifo)) for arg in FIFO_FLAGS[flag]]
+    done = subprocess.run(
+        [sys.executable, "-m", "plateimpact.cli", *argv], capture_output=True, text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert_one_line(done.returncode, done.stderr, "a named pipe (FIFO)")
+
+
+def test_a_pipe_from_the_shell_is_read(tmp_path):
+    """Process substitution hands over a pipe through /dev/fd: read as a file is."""
+    plate = tmp_path / "plate.json"
+    plate.write_text(
+        '{"format": "plateimpact-plate-1", "material": "x", "thickness_mm": 3.18, '
+        '"a_N_m2": 1.01e9, "b_kg_m3": 1260, "pstar_mm": 3.0, "alpha_deg": 45}'
+    )
+    read, write = os.pipe()
+    with os.fdopen(write, "wb") as sink:
+        sink.write(plate.read_bytes())
+    try:
+        code, out, err = run_cli(["run", "--plate-file", f"/dev/fd/{read}", *SCENE])
+    finally:
+        os.close(read)
+    assert code == 0, err
+    from_file = run_cli(["run", "--plate-file", str(plate), *SCENE])[1]
+    assert out.split(":", 1)[1] == from_file.split(":", 1)[1]  # all but the label

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 from collections.abc import Callable
 from typing import Any
 
@@ -143,6 +144,7 @@ def load_json_file(
     ``max_bytes`` are read, never the whole of a huge file); a file that cannot be read
     is ``error`` too, naming it (printable, cut to 200 characters)."""
     what = printable(os.fspath(path), 200)
+    check_input(path, what, error)
     try:
         with open(path, "rb") as handle:
             data = handle.read(max_bytes + 1)
@@ -151,6 +153,23 @@ def load_json_file(
     except ValueError as exc:  # a NUL in the path
         raise error(f"{what}: cannot read: {exc}") from None
     return load_json(data, what, error, max_bytes=max_bytes)
+
+
+def check_input(path: str | os.PathLike[str], what: str, error: ErrorFactory) -> None:
+    """Refuse, before it is opened, an input file that would hang its reader: a named
+    pipe (FIFO) in the filesystem, which a tarball can ship and whose open waits for a
+    writer that may never come. A pipe the shell hands over (``<(gunzip -c f.gz)``,
+    ``/dev/stdin``) is reached through a link in ``/dev/fd`` and is read as usual; a
+    path that cannot be examined is left to the open, which says why."""
+    try:
+        mode = os.lstat(path).st_mode
+    except (OSError, ValueError):
+        return
+    if stat.S_ISFIFO(mode):
+        raise error(
+            f"{what}: a named pipe (FIFO), whose reading would wait for a writer; give a "
+            "regular file (or a pipe from the shell, <(command))"
+        )
 
 
 class _Overlong:

@@ -13,6 +13,7 @@ import attrs
 import numpy as np
 
 from plateimpact import Parameter, ParameterError, SceneBatch
+from plateimpact.untrusted import check_input
 
 from .plate_constants import CRITICAL_PENETRATION
 from .separation import PlaneSeparation
@@ -110,6 +111,7 @@ class PstarTable:
     def from_csv(cls, path: str | os.PathLike[str]) -> PstarTable:
         """A table from a CSV file with the header of :data:`TABLE_COLUMNS` (any order)."""
         where = f"{os.fspath(path)!r:.200}"  # repr: control characters escaped
+        check_input(path, where, _fail)
         try:
             with open(path, "rb") as handle:  # never more than a table can hold
                 data = handle.read(MAX_BYTES + 1)

@@ -35,6 +35,7 @@ from ..errors import ParameterError, ShotDataError
 from ..parameters import Parameter
 from ..results import RESULT_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY
+from ..untrusted import check_input
 from .shot_reader import (
     MAX_SHOTS,
     ShotColumns,
@@ -225,6 +226,7 @@ class Shots:
         """Shots from a CSV file (see the module's description of the columns), read a
         row at a time."""
         source = os.fspath(path)
+        check_input(source, source, ShotDataError)
         try:
             with open(source, encoding="utf-8-sig", newline="") as handle:  # BOM allowed
                 return _of_rows(check_all(csv_records(handle, source), source, "line"), source)
