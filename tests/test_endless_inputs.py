@@ -1,38 +1,63 @@
-"""An input file without end (``/dev/zero``) or with a field beyond reason is one line
-and exit code 2 at every input flag: each reader reads at most what its file can hold
-(16 MB of JSON, 1 MB for a P* table; a shot file a line of at most 65,536 characters at
-a time), never the whole of it."""
+"""An input file without end or with a field beyond reason is one line and exit code 2 at
+every input flag: each reader reads at most what its file can hold (16 MB of JSON, 1 MB
+for a P* table; a shot file a line of at most 65,536 characters at a time), never the
+whole of it. Named pipes and device nodes a tarball can ship are refused before they are
+opened; a pipe from the shell is read as a file is."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
+import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from test_output_files import assert_one_line, run_cli
 
-ENDLESS = "/dev/zero"
 SCENE = ["--speed", "500", "--obliquity", "30"]
 
 
-@pytest.mark.skipif(not os.path.exists(ENDLESS), reason="no /dev/zero here")
+@contextlib.contextmanager
+def endless_pipe() -> Iterator[str]:
+    """``/dev/fd/N``: the read end of a pipe that a thread fills with zeros for as long
+    as it is open (as ``<(yes)`` would), closed afterwards, which ends the thread."""
+    read, write = os.pipe()
+    os.set_inheritable(read, True)
+
+    def fill() -> None:
+        with contextlib.suppress(OSError), os.fdopen(write, "wb", buffering=0) as sink:
+            block = bytes(1 << 16)
+            while True:
+                sink.write(block)  # BrokenPipeError once the read end is closed
+
+    thread = threading.Thread(target=fill, daemon=True)
+    thread.start()
+    try:
+        yield f"/dev/fd/{read}"
+    finally:
+        os.close(read)
+        thread.join()
+
+
 @pytest.mark.parametrize(
     ("argv", "words"),
     [
-        (["run", "--inputs", ENDLESS], "bytes of JSON"),
-        (["run", "--plate-file", ENDLESS, *SCENE], "bytes of JSON"),
-        (["validate", ENDLESS, "--preset", "2024-T3/3.18"], "longer than 65,536 characters"),
-        (["v50", ENDLESS], "longer than 65,536 characters"),
-        (["calibrate", ENDLESS, "--preset", "2024-T3/3.18"], "longer than 65,536 characters"),
+        (["run", "--inputs", "{}"], "bytes of JSON"),
+        (["run", "--plate-file", "{}", *SCENE], "bytes of JSON"),
+        (["validate", "{}", "--preset", "2024-T3/3.18"], "longer than 65,536 characters"),
+        (["v50", "{}"], "longer than 65,536 characters"),
+        (["calibrate", "{}", "--preset", "2024-T3/3.18"], "longer than 65,536 characters"),
         (["run", "--preset", "SAE1010/1.47", *SCENE, "--failure", "variable-pstar",
-          "--pstar-table", ENDLESS], "bytes; a table"),
+          "--pstar-table", "{}"], "bytes; a table"),
     ],
     ids=["run --inputs", "--plate-file", "validate", "v50", "calibrate", "--pstar-table"],
 )  # fmt: skip
 def test_an_endless_input_file_is_one_line(argv, words):
-    code, out, err = run_cli(argv)
+    with endless_pipe() as endless:
+        code, out, err = run_cli([arg.replace("{}", endless) for arg in argv])
     assert_one_line(code, err, words)
     assert out == ""
 
@@ -56,6 +81,15 @@ FIFO_FLAGS = {
     "--pstar-table": ["run", "--preset", "SAE1010/1.47", *SCENE, "--failure", "variable-pstar",
                       "--pstar-table", "{}"],
 }  # fmt: skip
+
+
+@pytest.mark.parametrize("flag", FIFO_FLAGS)
+def test_a_device_shipped_as_an_input_file_is_one_line(flag):
+    """/dev/zero stands for any device node a tarball could ship (a terminal would wait
+    for typing): refused before it is read."""
+    argv = [arg.replace("{}", "/dev/zero") for arg in FIFO_FLAGS[flag]]
+    code, out, err = run_cli(argv)
+    assert_one_line(code, err, "a device, not a file")
 
 
 @pytest.mark.parametrize("flag", FIFO_FLAGS)

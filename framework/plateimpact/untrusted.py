@@ -156,11 +156,13 @@ def load_json_file(
 
 
 def check_input(path: str | os.PathLike[str], what: str, error: ErrorFactory) -> None:
-    """Refuse, before it is opened, an input file that would hang its reader: a named
-    pipe (FIFO) in the filesystem, which a tarball can ship and whose open waits for a
-    writer that may never come. A pipe the shell hands over (``<(gunzip -c f.gz)``,
-    ``/dev/stdin``) is reached through a link in ``/dev/fd`` and is read as usual; a
-    path that cannot be examined is left to the open, which says why."""
+    """Refuse, before it is opened, an input file that could hang its reader or is no
+    file at all: a named pipe (FIFO), whose open waits for a writer that may never come,
+    and a device node (a terminal waits for typing; a disk is no shot file), either of
+    which a tarball can ship under an ordinary name. A pipe the shell hands over
+    (``<(gunzip -c f.gz)``, ``/dev/stdin``) is reached through a link in ``/dev/fd`` and
+    is read as usual; a path that cannot be examined is left to the open, which says
+    why."""
     try:
         mode = os.lstat(path).st_mode
     except (OSError, ValueError):
@@ -170,6 +172,8 @@ def check_input(path: str | os.PathLike[str], what: str, error: ErrorFactory) ->
             f"{what}: a named pipe (FIFO), whose reading would wait for a writer; give a "
             "regular file (or a pipe from the shell, <(command))"
         )
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        raise error(f"{what}: a device, not a file; give a regular file")
 
 
 class _Overlong:
