@@ -117,6 +117,10 @@ _EXPORTS: dict[str, str] = {
     "PlateImpactWarning": "errors",
     "ArchiveWaitWarning": "errors",
     "PluginLoadWarning": "errors",
+    # files from someone else (a plug-in that reads a file a user names checks it first)
+    "check_input": "untrusted",
+    "load_json": "untrusted",
+    "printable": "untrusted",
 }
 #: Submodules users reach as attributes (``pi.units.mm``).
 _SUBMODULES = (
@@ -228,6 +232,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .storage.shots import Shots
     from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
+    from .untrusted import check_input, load_json, printable
     from .v50 import MilStd662F, V50Fit, fit_v50, mil_std_662f
     from .variant import Variant
 

@@ -12,8 +12,7 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import Parameter, ParameterError, SceneBatch
-from plateimpact.untrusted import check_input
+from plateimpact import Parameter, ParameterError, SceneBatch, check_input
 
 from .plate_constants import CRITICAL_PENETRATION
 from .separation import PlaneSeparation
