@@ -11,6 +11,7 @@ that the archive reads as undamaged."""
 from __future__ import annotations
 
 import contextlib
+import csv
 import io
 import json
 import warnings
@@ -25,6 +26,7 @@ from plateimpact import limits, presets
 from plateimpact.cli import main
 from plateimpact.errors import PlateImpactError, PlateImpactWarning
 from plateimpact.storage.hdf5 import seal
+from plateimpact.untrusted import spreadsheet_safe
 
 #: A new line that forges an error line, an escape sequence, a carriage return and a
 #: right-to-left override.
@@ -233,3 +235,42 @@ def test_a_pstar_tables_hostile_header_and_cells_are_one_inert_line(tmp_path):
                                   "--obliquity", "45", "--failure", "variable-pstar",
                                   "--pstar-table", str(table)])  # fmt: skip
         assert_one_inert_line(code, err)
+
+
+# -- CSV cells a spreadsheet would run -------------------------------------------------------
+
+FORMULA = '=HYPERLINK("http://example.invalid","x")'
+
+
+def test_a_formula_from_a_file_is_written_to_csv_as_text(tmp_path, monkeypatch):
+    """A plate label from someone else's archive, or the name of a plate file they sent,
+    that begins as a formula does reaches a CSV cell with a leading ' (spreadsheets show
+    it as text, OWASP's rule for CSV injection): an exported run, a sweep."""
+    path = tmp_path / "a.h5"
+    study = pi.Study.grid("s", ["2024-T3/3.18"], [45], [300.0, 900.0], [pi.Variant("v")])
+    study.run(archive=path)
+    with h5py.File(path, "r") as f:
+        scenes = path.parent / f["s"].get("scenes", getlink=True).filename
+    with h5py.File(scenes, "r+") as d:
+        d["plate"][...] = np.array([FORMULA] * d["plate"].shape[0], dtype=d["plate"].dtype)
+    out = tmp_path / "v.csv"
+    assert run_cli(["export", str(path), "--run", "v", "--to", str(out)])[0] == 0
+    rows = list(csv.reader(out.read_text().splitlines()))
+    assert [row[0] for row in rows[1:]] == ["'" + FORMULA] * 2
+    monkeypatch.chdir(tmp_path)  # the sweep's label is the plate file's name as typed
+    Path("@SUM(1+1).json").write_text(plate_text())
+    argv = ["sweep", "--plate-file", "@SUM(1+1).json", "--speeds", "300,900",
+            "--obliquities", "45", "--csv", "sweep.csv"]  # fmt: skip
+    assert run_cli(argv)[0] == 0
+    rows = list(csv.reader(Path("sweep.csv").read_text().splitlines()))
+    assert {row[0] for row in rows[1:]} == {"'@SUM(1+1).json"}
+
+
+@pytest.mark.parametrize(
+    ("cell", "written"),
+    [("=1+1", "'=1+1"), ("+A1", "'+A1"), ("-cmd", "'-cmd"), ("@x", "'@x"), ("\tx", "'\tx"),
+     ("-1.5", "-1.5"), ("+2e3", "+2e3"), ("2024-T3/3.18", "2024-T3/3.18"), ("", "")],
+)  # fmt: skip
+def test_only_text_that_begins_as_a_formula_is_changed(cell, written):
+    """Numbers (a signed one too) and ordinary labels are written as they are."""
+    assert spreadsheet_safe(cell) == written

@@ -219,6 +219,25 @@ def described(value: object) -> str:
     return quoted(value)
 
 
+#: What a spreadsheet reads as the start of a formula in a CSV cell.
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def spreadsheet_safe(cell: str) -> str:
+    """A text cell of a CSV file that a spreadsheet will not run: text from someone
+    else's file (a plate label, a material, a shot's source) that begins as a formula
+    does (``=HYPERLINK(...)``, ``@SUM``, ``+``, ``-``) gets a leading ``'``, which
+    spreadsheets show as text (the OWASP rule for CSV injection); a number (``-1.5``)
+    and every other cell are written as they are."""
+    if not cell.startswith(FORMULA_STARTS):
+        return cell
+    try:
+        float(cell)
+    except ValueError:
+        return "'" + cell
+    return cell
+
+
 def printable(text: object, limit: int | None = None) -> str:
     """``text`` with every character a terminal would act on or hide escaped as Python
     writes it (``\\x1b``, ``\\n``, ``\\u202e``), so that it prints as one inert line;

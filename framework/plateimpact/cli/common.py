@@ -28,7 +28,7 @@ from ..storage.output import (
     write_text,
 )
 from ..storage.together import Output
-from ..untrusted import printable
+from ..untrusted import printable, spreadsheet_safe
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -221,19 +221,21 @@ def discard_stdout() -> None:
 
 
 def csv_text(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:
-    """CSV with ``header``; floats written exactly (repr), booleans as true/false."""
+    """CSV with ``header``; floats written exactly (repr), booleans as true/false, text
+    that a spreadsheet would run as a formula made inert (untrusted.spreadsheet_safe)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)
     for row in rows:
-        writer.writerow(
-            [
-                str(x).lower()
-                if isinstance(x, bool)
-                else repr(float(x))
-                if isinstance(x, float)
-                else x
-                for x in row
-            ]
-        )
+        writer.writerow([_cell(x) for x in row])
     return buffer.getvalue()
+
+
+def _cell(value: object) -> object:
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, float):
+        return repr(float(value))  # numpy's floats too, written as Python's
+    if isinstance(value, str):
+        return spreadsheet_safe(value)
+    return value

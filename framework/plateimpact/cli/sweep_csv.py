@@ -17,6 +17,7 @@ from ..bodies import Plate, Sphere
 from ..results import RESULT_FIELDS, BatchResult, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
+from ..untrusted import spreadsheet_safe
 
 #: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
 SWEEP_COLUMNS = (
@@ -37,7 +38,7 @@ _OUTCOME_LABELS = np.array(["", *(o.label for o in Outcome)])
 def csv_field(text: str) -> str:
     """``text`` as a CSV writer writes it among other fields (quoted where it must be)."""
     buffer = io.StringIO()
-    csv.writer(buffer, lineterminator="\n").writerow([text, ""])
+    csv.writer(buffer, lineterminator="\n").writerow([spreadsheet_safe(text), ""])
     return buffer.getvalue()[: -len(",\n")]
 
 

@@ -35,7 +35,7 @@ from ..errors import ParameterError, ShotDataError
 from ..parameters import Parameter
 from ..results import RESULT_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY
-from ..untrusted import check_input
+from ..untrusted import check_input, spreadsheet_safe
 from .shot_reader import (
     MAX_SHOTS,
     ShotColumns,
@@ -271,7 +271,7 @@ class Shots:
                 RADIUS.key: _exact(self.radius[i], RADIUS),
                 MASS.key: _exact(self.mass[i], MASS),
                 "weight": _exact(self.weight[i]),
-                "source": self.notes[i],
+                "source": spreadsheet_safe(self.notes[i]),
             }
             writer.writerow([cells[c] for c in header])
         return buffer.getvalue()
