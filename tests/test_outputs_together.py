@@ -42,6 +42,16 @@ PAIRS = [
 IDS = [f"{argv[0]} {first[0]}" for argv, first, _ in PAIRS]
 
 
+@pytest.fixture(autouse=True)
+def python_sigint():
+    """SIGINT as Python installs it (KeyboardInterrupt). A shell without job control starts
+    a background job (``pytest &``, a CI runner) with SIGINT ignored, and Python keeps an
+    ignored SIGINT ignored: the interrupts these tests send would then do nothing."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
 def run_cli(argv: list[str]) -> tuple[int, str, str]:
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
