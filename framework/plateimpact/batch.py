@@ -168,7 +168,8 @@ class SceneBatch:
         obliquities: np.ndarray | Iterable[float],
         chunk_size: int,
     ) -> Iterator[SceneBatch]:
-        """The scenes of :meth:`grid`, in its order and with the same values, as batches
+        """The scenes of :meth:`grid` (``speeds`` [m/s] × ``obliquities`` [rad]), in its
+        order and with the same values, as batches
         of ``chunk_size`` scenes (the last one shorter), each built only when asked for:
         memory holds one chunk, however large the grid. Checked before the first."""
         speeds, obliquities = _grid_axes(sphere, plate, speeds, obliquities)

@@ -38,6 +38,10 @@ class FailureModel(Plugin, ABC):
     array of shape ``(len(state_names), n)``, sets them with :meth:`initial_state` at
     onset and advances them with :meth:`state_rates`. ``state`` arguments are that array,
     restricted to the failed scenes; stateless models get shape ``(0, n)`` and ignore it.
+
+    **Arguments**, arrays with one entry per scene: ``penetration`` P [m], ``obliquity``
+    θ [rad] (always >= 0: the model sees the mirror image of a path that has swung
+    across the normal), ``speed`` V [m/s], ``obliquity_rate`` dθ/dt [rad/s].
     """
 
     #: Names of the variables this model integrates after failure (default: none).

@@ -46,7 +46,8 @@ def entry_edge_angle(penetration: np.ndarray, radius: np.ndarray) -> np.ndarray:
 def force_inclination(
     penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
 ) -> np.ndarray:
-    """φ [rad], the angle of the contact-plane normal (the force) from the plate normal.
+    """φ [rad], the angle of the contact-plane normal (the force) from the plate normal;
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m], one per scene.
 
     The contact chord joins the two ends of the contact arc in the plane of motion; φ is
     its normal, i.e. the bisector of the ends. Eq 6 is that bisector with the upper end at
@@ -99,7 +100,8 @@ def _limit_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
 def contact_geometry(
     penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Presented area A [m²] (eq 2) and force inclination φ [rad] (eq 6).
+    """Presented area A [m²] (eq 2) and force inclination φ [rad] (eq 6) at
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m], one per scene.
 
     A is the projection of the contact surface on the contact plane. By the divergence
     theorem it equals the projections of the two flat faces that close the contact
@@ -158,7 +160,8 @@ def contact_lost_margin(
     penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
 ) -> np.ndarray:
     """>= 0 once the sphere moves away from every point of the plate (the forward
-    hemisphere and the below-surface cap no longer meet): θ − π/2 >= α1.
+    hemisphere and the below-surface cap no longer meet): θ − π/2 >= α1, at
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m]; the margin [m].
 
     Written without α1's arccos, whose slope is infinite at P = 0, where shallow
     ricochets end: for θ >= π/2 both angles lie in [0, π], where the cosine decreases, so

@@ -73,6 +73,10 @@ class ImpactModel:
         The embedment rule (docs/model.md, "rest"): a sphere is at rest when its speed
         falls to this fraction of its impact speed; its exit obliquity is its direction
         then. In (0, 1); default 0.01.
+
+    The methods take arrays with one entry per scene: ``penetration`` P [m],
+    ``obliquity`` θ [rad], ``speed`` V [m/s], ``obliquity_rate`` dθ/dt [rad/s]; ``y``
+    the state rows :data:`PENETRATION` ... in those units.
     """
 
     resistance: ResistanceLaw = attrs.field(validator=_plugin_of(ResistanceLaw))

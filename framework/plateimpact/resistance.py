@@ -50,7 +50,8 @@ def contact_force(
     speed: np.ndarray,
     batch: SceneBatch,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Drag and lift [N] of ``law`` on the contact surface (eqs 1, 22–24).
+    """Drag and lift [N] of ``law`` on the contact surface (eqs 1, 22–24) at
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``speed`` V [m/s], one per scene.
 
     ``penetration`` is measured from the plane bounding the resisting material: the front
     surface for the intact force F*, the failure plane (P − h) for the relieved force F′
@@ -82,5 +83,6 @@ class BoundResistance:
         self, penetration: np.ndarray, obliquity: np.ndarray, speed: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         """Drag and lift [N] on the contact surface below a plane ``penetration`` [m] above
-        the sphere's deepest point (:func:`contact_force`)."""
+        the sphere's deepest point, at ``obliquity`` θ [rad] and ``speed`` V [m/s]
+        (:func:`contact_force`)."""
         return contact_force(self.law, penetration, obliquity, speed, self.batch)

@@ -115,7 +115,9 @@ class Study:
         sphere: Sphere = presets.DEFAULT_SPHERE,
         description: str = "",
     ) -> Study:
-        """Every plate × obliquity [deg] × speed [m/s]; plates by preset name or Plate."""
+        """Every plate × obliquity × speed: ``obliquities_deg`` [deg] (the name says so:
+        :meth:`SceneBatch.grid` takes radians), ``speeds`` [m/s]; plates by preset name
+        or Plate."""
         batches, labels = [], []
         plates = _tuple("plates", plates)  # type: ignore[assignment]
         if not plates:

@@ -50,7 +50,8 @@ _ALL = (1 << Outcome.RICOCHET) | (1 << Outcome.EMBEDMENT) | (1 << Outcome.PERFOR
 
 @attrs.frozen
 class ProbabilityModel:
-    """Speed scatter s [m/s] (> 0) and residual-speed scatter σ_r [m/s] (None: fitted)."""
+    """Speed scatter ``speed_sigma`` s [m/s] (> 0) and residual-speed scatter
+    ``residual_sigma`` σ_r [m/s] (None: fitted)."""
 
     speed_sigma: float = SPEED_SIGMA
     residual_sigma: float | None = None

@@ -198,7 +198,8 @@ class PstarRow:
 
 @attrs.frozen(eq=False)
 class PstarTableFit:
-    """The variable-P* table fitted to shots, one row per impact obliquity."""
+    """The variable-P* table fitted to shots, one row per impact obliquity, with the
+    ``alpha`` α* [rad] it was fitted at."""
 
     rows: tuple[PstarRow, ...]
     alpha: float

@@ -78,7 +78,8 @@ def model_residual_speeds(
     constants: Sequence[tuple[float, float]],
 ) -> np.ndarray:
     """Residual speeds [m/s] of the model at normal incidence, shape (len(constants),
-    len(impact_speeds)), for each (a [N/m²], b [kg/m³]) in ``constants``; one batch,
+    len(impact_speeds)), at ``impact_speeds`` [m/s], for each (a [N/m²], b [kg/m³]) in
+    ``constants``; one batch,
     run RUN_CHUNK scenes at a time. Embedments give 0."""
     speeds = np.asarray(impact_speeds, dtype=float)
     a, b = (np.array([c[k] for c in constants], dtype=float) for k in (0, 1))

@@ -36,9 +36,11 @@ MAX_MAP_SCENES = 1_000_000
 
 @attrs.frozen(eq=False)
 class OutcomeMap:
-    """Regimes and exit states on a grid of impact speeds [m/s] (columns) and
-    obliquities [rad] (rows), and ``limits``: the bands along each row, boundaries
-    located to ``limits.tolerance`` with the grid's spacing as resolution."""
+    """Regimes and exit states on a grid of impact ``speeds`` [m/s] (columns) and
+    ``obliquities`` [rad] (rows): ``regime`` (an :class:`~plateimpact.Outcome` per
+    cell), ``exit_speed`` [m/s] and ``exit_obliquity`` [rad]; and ``limits``: the bands
+    along each row, boundaries located to ``limits.tolerance`` with the grid's spacing
+    as resolution."""
 
     speeds: np.ndarray
     obliquities: np.ndarray
@@ -123,7 +125,9 @@ def outcome_maps(
     tolerance: float = SPEED_TOLERANCE,
     executor: Executor | None = None,
 ) -> list[OutcomeMap]:
-    """The outcome maps of several plates on one grid, found together: their rows share
+    """The outcome maps of several plates on one grid (``speeds`` (start, stop) [m/s],
+    ``speed_samples`` of them, ``obliquities`` [rad], boundaries to ``tolerance`` [m/s],
+    as :func:`outcome_map`), found together: their rows share
     the batches, and so the refinement passes, which cost more than their scenes (five
     plates take about three times as long as one). The plates must declare the same
     constants."""
