@@ -24,7 +24,7 @@ import pytest
 from conftest import THIRD_PARTY
 
 import plateimpact as pi
-import plateimpact.study as study_module
+import plateimpact.simulation as simulation_module
 from plateimpact import limits, presets
 from plateimpact.cli import main
 from plateimpact.storage import code_provenance
@@ -91,13 +91,13 @@ def installed() -> pi.PluginRegistry:
 def scenes_run(monkeypatch):
     """The sizes of the chunks of scenes the studies compute."""
     sizes: list[int] = []
-    real = study_module.run_chunk
+    real = simulation_module.run_chunk
 
     def counted(simulation, chunk, *args):
         sizes.append(chunk.size)
         return real(simulation, chunk, *args)
 
-    monkeypatch.setattr(study_module, "run_chunk", counted)
+    monkeypatch.setattr(simulation_module, "run_chunk", counted)
     return sizes
 
 

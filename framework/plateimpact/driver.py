@@ -39,15 +39,17 @@ from .results import BatchResult, Outcome
 def integrate(
     model: ImpactModel,
     integrator: Integrator,
-    batch: SceneBatch,
+    batch: SceneBatch | BoundBatch,
     *,
     record_trajectory: bool = False,
 ) -> BatchResult:
     """Integrate every scene of ``batch`` from first contact, (P, Y, θ, V) = (0, 0, θs,
-    Vs), to its outcome."""
+    Vs), to its outcome. A :class:`BoundBatch` (``model.bind``, or a part of one) is
+    used as it is, so that a run bound once can be integrated in parts."""
     recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
     if batch.size:
-        _integrate(model, integrator, model.bind(batch), recorder)
+        bound = batch if isinstance(batch, BoundBatch) else model.bind(batch)
+        _integrate(model, integrator, bound, recorder)
     return recorder.result()
 
 

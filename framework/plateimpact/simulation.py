@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import Executor
 from typing import Any
 
@@ -10,6 +10,7 @@ import attrs
 import numpy as np
 
 from .batch import SceneBatch, check_chunk_size
+from .binding import BoundBatch
 from .crater import crater_sections
 from .driver import integrate
 from .errors import ParameterError, PluginError
@@ -105,26 +106,12 @@ class Simulation:
         """
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
         check_chunk_size(chunk_size)
-        if executor is None or batch.size <= chunk_size:
-            result = run_chunk(self, batch, record_trajectory, craters)
-            report_scenes(batch.size)
-            return result
-        bounds = range(0, batch.size, chunk_size)
-        futures = [
-            executor.submit(
-                run_chunk,
-                self,
-                batch.take(np.arange(lo, min(lo + chunk_size, batch.size))),
-                record_trajectory,
-                craters,
-            )
-            for lo in bounds
-        ]
-        parts = []
-        for future in futures:
-            parts.append(future.result())
-            report_scenes(len(parts[-1]))
-        return BatchResult.concat(parts)
+        if executor is None:  # one process: one batch, the fastest way through the loop
+            chunk_size = max(batch.size, 1)
+        bound = self.model.bind(batch)
+        return run_in_chunks(
+            self, bound, chunk_size, executor, record_trajectory, craters, report_scenes
+        )
 
     def run(self, scene: Scene, *, record_trajectory: bool = False) -> Result:
         """The result of one scene."""
@@ -151,19 +138,56 @@ def _settings(kind: str, settings: object) -> dict[str, Any]:
     return dict(settings)
 
 
-def run_chunk(
-    simulation: Simulation, batch: SceneBatch, record_trajectory: bool, craters: bool = False
+def run_in_chunks(
+    simulation: Simulation,
+    bound: BoundBatch,
+    chunk_size: int,
+    executor: Executor | None,
+    record_trajectory: bool,
+    craters: bool,
+    advance: Callable[[int], object],
 ) -> BatchResult:
-    """One chunk of a batch, in an executor's worker (picklable: a module function);
+    """The one dispatch of a run (:meth:`Simulation.run_batch`, :meth:`Study.run`): the
+    scenes of ``bound`` (bound once, so plate constants are checked and plug-ins'
+    columns prepared once per run) in chunks of ``chunk_size``, in this process or on
+    ``executor``, results in order; ``advance(n)`` after each chunk (a progress bar).
+    A scene's result does not depend on its chunk: chunking changes only the wall time
+    and how often ``advance`` is called."""
+    parts = []
+    chunks = (
+        bound.take(np.arange(lo, min(lo + chunk_size, bound.size)))
+        if chunk_size < bound.size
+        else bound
+        for lo in range(0, max(bound.size, 1), chunk_size)
+    )
+    if executor is None:
+        for chunk in chunks:
+            parts.append(run_chunk(simulation, chunk, record_trajectory, craters))
+            advance(chunk.size)
+    else:
+        futures = [
+            (executor.submit(run_chunk, simulation, chunk, record_trajectory, craters), chunk.size)
+            for chunk in chunks
+        ]
+        for future, size in futures:
+            parts.append(future.result())
+            advance(size)
+    return parts[0] if len(parts) == 1 else BatchResult.concat(parts)
+
+
+def run_chunk(
+    simulation: Simulation, bound: BoundBatch, record_trajectory: bool, craters: bool = False
+) -> BatchResult:
+    """One chunk of a run, in an executor's worker (picklable: a module function);
     crater sections, when asked for, are computed there too."""
     result = integrate(
         simulation.model,
         simulation.integrator,
-        batch,
+        bound,
         record_trajectory=record_trajectory or craters,
     )
     if craters:
-        result.craters = crater_sections(result, batch.radius, batch.thickness)
+        result.craters = crater_sections(result, bound.core.radius, bound.core.thickness)
     return result
 
 

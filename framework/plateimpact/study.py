@@ -21,7 +21,7 @@ from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult
 from .scene import Scene
-from .simulation import DEFAULT_CHUNK_SIZE, run_chunk
+from .simulation import DEFAULT_CHUNK_SIZE, run_in_chunks
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError
 from .storage.provenance import RunMetadata
@@ -242,8 +242,9 @@ class Study:
             v.name: v.simulation(registry) for v in self.variants if v.name not in finished
         }
         constants = {}
-        for simulation in simulations.values():  # a bad plate constant: refused before any run
-            simulation.model.bind(self.scenes)
+        bound = {}  # each model bound once: a bad plate constant is refused before any run
+        for name, simulation in simulations.items():
+            bound[name] = simulation.model.bind(self.scenes)
             constants.update(simulation.model.plate_constants())
         runs: dict[str, BatchResult] = {}
         with progress_bar(self.scenes.size * len(self.variants), self.name, progress) as bar:
@@ -257,26 +258,15 @@ class Study:
                         runs[variant.name] = kept
                         bar.update(self.scenes.size)
                         continue
-                simulation = simulations.get(variant.name) or variant.simulation(registry)
+                if variant.name not in simulations:  # kept, but lacking what was asked for
+                    simulations[variant.name] = variant.simulation(registry)
+                    bound[variant.name] = simulations[variant.name].model.bind(self.scenes)
+                simulation = simulations[variant.name]
                 metadata = RunMetadata(variant, simulation)
-                chunks = [
-                    self.scenes.take(np.arange(lo, min(lo + chunk_size, self.scenes.size)))
-                    for lo in range(0, self.scenes.size, chunk_size)
-                ]
-                parts = []
-                if executor is None:
-                    for chunk in chunks:
-                        parts.append(run_chunk(simulation, chunk, record_trajectory, craters))
-                        bar.update(chunk.size)
-                else:
-                    futures = [
-                        executor.submit(run_chunk, simulation, chunk, record_trajectory, craters)
-                        for chunk in chunks
-                    ]
-                    for future, chunk in zip(futures, chunks, strict=True):
-                        parts.append(future.result())
-                        bar.update(chunk.size)
-                result = BatchResult.concat(parts)
+                result = run_in_chunks(
+                    simulation, bound.pop(variant.name), chunk_size, executor,
+                    record_trajectory, craters, bar.update,
+                )  # fmt: skip
                 metadata.finish()
                 runs[variant.name] = result
                 if writer is not None:
