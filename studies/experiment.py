@@ -24,13 +24,13 @@ from typing import Any
 
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
-from plateimpact.errors import PlateImpactError
+from plateimpact.base.errors import PlateImpactError
+from plateimpact.base.untrusted import load_json
 from plateimpact.experiment.figure import validation_figure
 from plateimpact.storage.code_provenance import plugins_record
 from plateimpact.storage.output import write_text
 from plateimpact.storage.provenance import versions
 from plateimpact.storage.source_hash import module_sources, source_sha256
-from plateimpact.untrusted import load_json
 from plateimpact.v50.figure import Panel, v50_figure
 
 DATA = Path(__file__).resolve().parent / "data"

@@ -15,9 +15,9 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import presets
+from plateimpact.base.errors import WorkBoundError
 from plateimpact.calibration import pstar_plan, pstar_search
 from plateimpact.calibration.outcome_model import ProbabilityModel, ShotLines
-from plateimpact.errors import WorkBoundError
 from plateimpact.limits import chunked
 from plateimpact.results import Outcome
 

@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "framework" / "plateimpact"
 LAYERS = {
     "physics": {
-        "units", "errors", "untrusted", "parameters", "bodies", "scene", "batch", "geometry",
+        "base", "units", "bodies", "scene", "batch", "geometry",
         "plugin", "resistance", "failure", "binding", "model", "results", "ragged", "crater",
         "presets",
     },

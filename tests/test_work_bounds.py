@@ -13,7 +13,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.errors import WorkBoundError
+from plateimpact.base.errors import WorkBoundError
 from plateimpact.limits import chunked, finder
 
 SPHERE = presets.DEFAULT_SPHERE

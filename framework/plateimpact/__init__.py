@@ -20,8 +20,8 @@ _EXPORTS: dict[str, str] = {
     "Plate": "bodies",
     "Scene": "scene",
     "SceneBatch": "batch",
-    "Parameter": "parameters",
-    "Range": "parameters",
+    "Parameter": "base.parameters",
+    "Range": "base.parameters",
     # plug-in interfaces
     "ResistanceLaw": "resistance",
     "BoundResistance": "resistance",
@@ -103,29 +103,36 @@ _EXPORTS: dict[str, str] = {
     "fit_v50": "v50",
     "mil_std_662f": "v50",
     # errors
-    "PlateImpactError": "errors",
-    "ParameterError": "errors",
-    "UnknownNameError": "errors",
-    "IntegrationError": "errors",
-    "ArchiveError": "errors",
-    "ShotDataError": "errors",
-    "PlateFileError": "errors",
-    "CalibrationError": "errors",
-    "ConvergenceError": "errors",
-    "V50Error": "errors",
-    "PluginError": "errors",
-    "PlateImpactWarning": "errors",
-    "ArchiveWaitWarning": "errors",
-    "PluginLoadWarning": "errors",
+    "PlateImpactError": "base.errors",
+    "ParameterError": "base.errors",
+    "UnknownNameError": "base.errors",
+    "IntegrationError": "base.errors",
+    "ArchiveError": "base.errors",
+    "ShotDataError": "base.errors",
+    "PlateFileError": "base.errors",
+    "CalibrationError": "base.errors",
+    "ConvergenceError": "base.errors",
+    "V50Error": "base.errors",
+    "PluginError": "base.errors",
+    "PlateImpactWarning": "base.errors",
+    "ArchiveWaitWarning": "base.errors",
+    "PluginLoadWarning": "base.errors",
     # files from someone else (a plug-in that reads a file a user names checks it first)
-    "check_input": "untrusted",
-    "load_json": "untrusted",
-    "printable": "untrusted",
+    "check_input": "base.untrusted",
+    "load_json": "base.untrusted",
+    "printable": "base.untrusted",
 }
-#: Submodules users reach as attributes (``pi.units.mm``).
-_SUBMODULES = (
-    "batch", "calibration", "experiment", "geometry", "limits", "presets", "units", "v50",
-)  # fmt: skip
+#: Submodules users reach as attributes (``pi.units.mm``) -> where each is.
+_SUBMODULES: dict[str, str] = {
+    "batch": "batch",
+    "calibration": "calibration",
+    "experiment": "experiment",
+    "geometry": "geometry",
+    "limits": "limits",
+    "presets": "presets",
+    "units": "units",
+    "v50": "v50",
+}
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
@@ -134,7 +141,7 @@ def __getattr__(name: str) -> Any:
     if name in _EXPORTS:
         value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
     elif name in _SUBMODULES:
-        value = importlib.import_module(f".{name}", __name__)
+        value = importlib.import_module(f".{_SUBMODULES[name]}", __name__)
     elif name == "__version__":
         from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
 
@@ -154,6 +161,24 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
     from . import batch, calibration, experiment, geometry, presets, units, v50
+    from .base.errors import (
+        ArchiveError,
+        ArchiveWaitWarning,
+        CalibrationError,
+        ConvergenceError,
+        IntegrationError,
+        ParameterError,
+        PlateFileError,
+        PlateImpactError,
+        PlateImpactWarning,
+        PluginError,
+        PluginLoadWarning,
+        ShotDataError,
+        UnknownNameError,
+        V50Error,
+    )
+    from .base.parameters import Parameter, Range
+    from .base.untrusted import check_input, load_json, printable
     from .binding import BoundBatch
     from .bodies import Plate, Sphere
     from .calibration import (
@@ -175,22 +200,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .dense import DenseOutput, PolynomialDenseOutput, hermite
     from .discovery import BrokenPackage
     from .dynamics import Dynamics
-    from .errors import (
-        ArchiveError,
-        ArchiveWaitWarning,
-        CalibrationError,
-        ConvergenceError,
-        IntegrationError,
-        ParameterError,
-        PlateFileError,
-        PlateImpactError,
-        PlateImpactWarning,
-        PluginError,
-        PluginLoadWarning,
-        ShotDataError,
-        UnknownNameError,
-        V50Error,
-    )
     from .experiment import ValidationReport, validate
     from .failure import FailureModel
     from .geometry import contact_geometry, contact_lost_margin, force_inclination
@@ -219,7 +228,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         TURNED_BACK,
         ImpactModel,
     )
-    from .parameters import Parameter, Range
     from .plugin import Column
     from .ragged import Ragged
     from .registry import PluginRegistry, default_registry, load_registry
@@ -232,7 +240,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .storage.shots import Shots
     from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
-    from .untrusted import check_input, load_json, printable
     from .v50 import MilStd662F, V50Fit, fit_v50, mil_std_662f
     from .variant import Variant
 

@@ -11,9 +11,9 @@ from collections.abc import Iterable, Iterator, Mapping
 
 import numpy as np
 
+from .base.errors import ParameterError
+from .base.parameters import Parameter, check_instance
 from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere, check_density
-from .errors import ParameterError
-from .parameters import Parameter, check_instance
 from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 
 #: The columns every batch has, whatever the model: the sphere, the plate's thickness

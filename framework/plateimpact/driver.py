@@ -14,11 +14,11 @@ import time
 
 import numpy as np
 
+from .base.errors import IntegrationError
 from .batch import SceneBatch
 from .binding import BoundBatch
 from .control import StepSizes
 from .dynamics import Dynamics
-from .errors import IntegrationError
 from .events import first_event, sample_step
 from .integrator import Integrator, StepperState
 from .model import (

@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 
+from .base.errors import ParameterError
+from .base.parameters import Parameter
 from .batch import CORE_COLUMNS
-from .errors import ParameterError
-from .parameters import Parameter
 from .registry import default_registry
 from .results import RESULT_FIELDS, BatchResult, Outcome
 from .storage.append import StudyDefinition

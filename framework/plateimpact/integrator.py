@@ -14,9 +14,9 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from .base.parameters import Parameter, Range
 from .dense import DenseOutput
 from .dynamics import Dynamics
-from .parameters import Parameter, Range
 from .plugin import Plugin
 
 #: Per-scene arrays a stepper carries from one accepted step to the next (last axis:

@@ -8,12 +8,12 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
+from .base.errors import ParameterError, PluginError
+from .base.parameters import Parameter, Range
 from .batch import CORE_COLUMNS, SceneBatch
 from .binding import BoundBatch
-from .errors import ParameterError, PluginError
 from .failure import FailureModel
 from .geometry import branch_margins, contact_lost_margin
-from .parameters import Parameter, Range
 from .plugin import Plugin
 from .resistance import BoundResistance, ResistanceLaw, contact_force
 from .results import Outcome

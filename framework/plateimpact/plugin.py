@@ -2,7 +2,7 @@
 
 A plug-in declares what it needs from the plate (:attr:`Plugin.plate_constants`) and
 what it computes once per batch (:attr:`Plugin.columns`); its settings are its attrs
-fields, declared with :meth:`Parameter.field <plateimpact.parameters.Parameter.field>`.
+fields, declared with :meth:`Parameter.field <plateimpact.base.parameters.Parameter.field>`.
 The core validates and namespaces all of it, so a plug-in never sees, and never
 overwrites, another's columns.
 """
@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from .parameters import Parameter, declared_settings
+from .base.parameters import Parameter, declared_settings
 
 
 @attrs.frozen

@@ -19,6 +19,14 @@ from typing import Any
 import pluggy
 
 from . import hookspecs
+from .base.errors import (
+    ParameterError,
+    PlateImpactError,
+    PluginError,
+    PluginLoadWarning,
+    UnknownNameError,
+)
+from .base.parameters import Parameter
 from .batch import CORE_COLUMNS
 from .discovery import (
     BrokenPackage,
@@ -29,16 +37,8 @@ from .discovery import (
     first_line,
     installed_entry_points,
 )
-from .errors import (
-    ParameterError,
-    PlateImpactError,
-    PluginError,
-    PluginLoadWarning,
-    UnknownNameError,
-)
 from .failure import FailureModel
 from .integrator import Integrator
-from .parameters import Parameter
 from .plugin import Plugin
 from .resistance import ResistanceLaw
 
@@ -262,13 +262,13 @@ def load_registry(*, entry_points: bool = True, plugins: Iterable[object] = ()) 
         Load the installed packages of the ``plateimpact`` entry-point group (the
         built-ins and any third-party package). A package that fails to load, whose hook
         is misspelled or raises, or one of whose classes the registry refuses, is
-        skipped with a :class:`~plateimpact.errors.PluginLoadWarning` and listed in
+        skipped with a :class:`~plateimpact.base.errors.PluginLoadWarning` and listed in
         :attr:`PluginRegistry.broken`; none of its classes is registered. False gives a
         registry of ``plugins`` only, which keeps a test independent of what else is
         installed.
     plugins : iterable of modules or objects
         Extra hook implementations to register directly. Any problem with one of them
-        raises :class:`~plateimpact.errors.PluginError`.
+        raises :class:`~plateimpact.base.errors.PluginError`.
     """
     manager = pluggy.PluginManager(hookspecs.PROJECT)
     manager.add_hookspecs(hookspecs)

@@ -8,7 +8,7 @@ import math
 import attrs
 import numpy as np
 
-from .parameters import Parameter
+from .base.parameters import Parameter
 from .ragged import Ragged
 
 _DEG, _MM = math.pi / 180.0, 1e-3

@@ -6,8 +6,8 @@ import math
 
 import attrs
 
+from .base.parameters import Parameter, Range, check_instance
 from .bodies import Plate, Sphere
-from .parameters import Parameter, Range, check_instance
 
 # From the speed of an indentation test (1 mm/s: the strength term a alone) to 10 km/s,
 # past which a sphere melts or vaporises on impact and no rigid-sphere Poncelet law holds

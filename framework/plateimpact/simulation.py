@@ -9,10 +9,10 @@ from typing import Any
 import attrs
 import numpy as np
 
+from .base.errors import ParameterError, PluginError
 from .batch import SceneBatch, check_chunk_size
 from .crater import crater_sections
 from .driver import integrate
-from .errors import ParameterError, PluginError
 from .integrator import Integrator
 from .model import REST_SPEED_FRACTION, ImpactModel
 from .progress import report_scenes

@@ -13,10 +13,10 @@ import attrs
 import numpy as np
 
 from . import presets
+from .base.errors import ArchiveWaitWarning, ParameterError, UnknownNameError
 from .batch import SceneBatch, check_chunk_size
 from .bodies import Plate, Sphere
 from .comparison.ranges import Comparison
-from .errors import ArchiveWaitWarning, ParameterError, UnknownNameError
 from .progress import progress_bar
 from .registry import PluginRegistry
 from .results import BatchResult

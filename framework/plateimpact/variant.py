@@ -9,11 +9,11 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .errors import ParameterError
+from .base.errors import ParameterError
+from .base.untrusted import load_json
 from .model import REST_SPEED_FRACTION
 from .registry import PluginRegistry
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
-from .untrusted import load_json
 
 
 def _json_value(value: object) -> object:

@@ -9,8 +9,8 @@ import attrs
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
 from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ConvergenceError, WorkBoundError
 from ..presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
@@ -339,7 +339,7 @@ def calibrate(
     max_scenes: int | None = MAX_FIT_SCENES,
 ) -> CalibrationReport:
     """The DRI fit of ``shots`` and a, b by both methods (``plate``: T, P*, α*).
-    :class:`~plateimpact.errors.WorkBoundError` before any scene runs if the fits could
+    :class:`~plateimpact.base.errors.WorkBoundError` before any scene runs if the fits could
     run more than ``max_scenes`` scenes (AB_SCENES_PER_SHOT per normal-incidence shot;
     None: no bound)."""
     simulation = simulation or Simulation.from_names()

@@ -15,9 +15,9 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
+from ..base.errors import ParameterError
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
-from ..errors import ParameterError
 from ..limits import locate, regime_codes
 from ..limits.chunked import run_chunked
 from ..limits.finder import RELATIVE_FLOOR

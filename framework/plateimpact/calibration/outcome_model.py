@@ -26,7 +26,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.special import ndtr, ndtri
 
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from ..results import Outcome
 from ..scene import IMPACT_SPEED
 

@@ -13,8 +13,8 @@ import math
 import attrs
 import numpy as np
 
+from ..base.errors import CalibrationError, ConvergenceError
 from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ConvergenceError
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..presets import DEFAULT_SPHERE
 from ..simulation import Simulation
@@ -140,7 +140,7 @@ def fit_pstar(
     ``plate`` gives a, b and α* (the start when fitted); ``resolution`` and
     ``tolerance`` [m/s] are the boundary finder's. Before any scene runs:
     :class:`CalibrationError` when the shots are too few or plainly cannot fix P*
-    (:func:`~.pstar_plan.unfittable`), :class:`~plateimpact.errors.WorkBoundError` when
+    (:func:`~.pstar_plan.unfittable`), :class:`~plateimpact.base.errors.WorkBoundError` when
     the fit would run more than about ``max_scenes`` scenes (None: no bound). After:
     :class:`CalibrationError` when the likelihood does not fix P*,
     :class:`ConvergenceError` when the search does not converge.
@@ -243,7 +243,7 @@ def fit_pstar_by_obliquity(
     before any scene runs: those where neither range can fix P* (too few shots, or all
     one outcome: :func:`~.pstar_plan.unfittable`) raise one :class:`CalibrationError`
     naming the first and counting the rest, and a fit over about ``max_scenes`` scenes a
-    :class:`~plateimpact.errors.WorkBoundError`; an obliquity whose likelihoods turn out
+    :class:`~plateimpact.base.errors.WorkBoundError`; an obliquity whose likelihoods turn out
     to fix neither raises :class:`CalibrationError` after the fit, all of them at once."""
     simulation = simulation or Simulation.from_names()
     model = model or ProbabilityModel()

@@ -9,12 +9,12 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.integrate import quad
 
+from ..base.errors import CalibrationError, ShotDataError
+from ..base.parameters import Range
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ShotDataError
 from ..geometry import contact_geometry
 from ..limits.chunked import run_chunked
-from ..parameters import Range
 from ..results import Outcome
 from ..simulation import Simulation
 from ..storage.shots import Shots

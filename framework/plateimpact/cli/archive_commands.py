@@ -9,6 +9,8 @@ from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
 
+from ..base.errors import ArchiveError, PluginError
+from ..base.untrusted import printable
 from ..discovery import (
     BrokenPackage,
     distribution_label,
@@ -16,13 +18,11 @@ from ..discovery import (
     first_line,
     installed_entry_points,
 )
-from ..errors import ArchiveError, PluginError
 from ..progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths
 from ..study import Study, StudyResults
-from ..untrusted import printable
 from .common import UsageError, add_dpi_option, check_directory, output_directory, say
 from .describe import run_description
 from .run_comparison import print_comparison

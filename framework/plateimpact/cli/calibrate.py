@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..base.units import g, mm
 from ..bodies import Plate, Sphere
 from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
 from ..calibration.pstar_plan import MAX_FIT_SCENES
@@ -21,7 +22,6 @@ from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions
 from ..storage.shots import Shots
 from ..storage.together import write_together
-from ..units import g, mm
 from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
 from .common import (
     add_dpi_option,

@@ -9,6 +9,7 @@ import math
 import os
 from typing import Any
 
+from ..base.units import g, mm
 from ..bodies import Plate, Sphere
 from ..calibration.model_lines import Cost, check_finder
 from ..calibration.outcome_model import (
@@ -31,7 +32,6 @@ from ..simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions
 from ..storage.shots import Shots
-from ..units import g, mm
 from .common import UsageError, check_directory, say, write_atomically
 from .options import bodies, model_choice, typed
 

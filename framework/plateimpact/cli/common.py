@@ -16,7 +16,8 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
-from ..errors import PlateImpactError
+from ..base.errors import PlateImpactError
+from ..base.untrusted import printable, spreadsheet_safe
 from ..storage.output import (
     FIGURE_DPI,
     FIGURE_DPI_RANGE,
@@ -28,7 +29,6 @@ from ..storage.output import (
     write_text,
 )
 from ..storage.together import Output
-from ..untrusted import printable, spreadsheet_safe
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

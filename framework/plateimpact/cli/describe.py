@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
 from ..batch import CORE_COLUMNS, SceneBatch
-from ..parameters import Parameter
 from ..registry import KINDS, default_registry
 from ..results import BatchResult
 from ..storage.archive import Archive
-from ..untrusted import printable
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.
 LISTED_VALUES = 6

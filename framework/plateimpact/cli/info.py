@@ -9,8 +9,8 @@ import json
 from typing import Any
 
 from .. import presets
+from ..base.parameters import Parameter
 from ..bodies import MASS, RADIUS, THICKNESS
-from ..parameters import Parameter
 from ..registry import KINDS, PluginRegistry, default_registry
 from .common import say
 from .describe import shown

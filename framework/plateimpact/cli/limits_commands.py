@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
-from ..errors import ArchiveError
+from ..base.errors import ArchiveError
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..results import Outcome

@@ -18,10 +18,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol, TextIO
 
+from ..base.errors import PlateImpactWarning
+from ..base.untrusted import printable
 from ..discovery import first_line
-from ..errors import PlateImpactWarning
 from ..storage.provenance import versions
-from ..untrusted import printable
 
 
 class ShowWarning(Protocol):

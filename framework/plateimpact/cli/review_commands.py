@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from ..storage.archive import Archive
 from ..storage.output import write_output
 from .common import UsageError, check_directory, csv_text, say

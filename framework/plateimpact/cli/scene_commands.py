@@ -8,9 +8,9 @@ from typing import Any
 
 import numpy as np
 
+from ..base.parameters import Parameter
 from ..bodies import Plate, Sphere
 from ..crater import crater_section
-from ..parameters import Parameter
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry, default_registry
 from ..results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import math
 
-from ..errors import UnknownNameError
+from ..base.errors import UnknownNameError
 from ..limits import LimitsComparison, OutcomeMap, compare_limits, read_limits
 from ..limits.compare import user
 from ..limits.lines import OBLIQUITY, SPEED, LimitLine

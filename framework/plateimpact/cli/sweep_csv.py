@@ -12,12 +12,12 @@ from collections.abc import Iterator
 import attrs
 import numpy as np
 
+from ..base.untrusted import spreadsheet_safe
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
 from ..results import RESULT_FIELDS, BatchResult, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
-from ..untrusted import spreadsheet_safe
 
 #: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
 SWEEP_COLUMNS = (

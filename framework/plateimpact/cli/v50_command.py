@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
+from ..base.errors import V50Error
 from ..bodies import Sphere
-from ..errors import V50Error
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..storage.shots import Shots

@@ -22,8 +22,8 @@ from typing import Any
 import attrs
 import numpy as np
 
+from ..base.errors import ParameterError
 from ..batch import SceneBatch
-from ..errors import ParameterError
 from ..limits.lines import OBLIQUITY, SPEED, unit_suffix
 from ..limits.regimes import Regime, regime_codes
 from ..results import BatchResult, Outcome

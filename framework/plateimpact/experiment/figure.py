@@ -10,8 +10,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ..base.errors import ShotDataError
 from ..batch import SceneBatch
-from ..errors import ShotDataError
 from ..plotting import (
     FONT,
     MAX_COLUMNS,

@@ -22,8 +22,8 @@ from typing import Any
 import attrs
 import numpy as np
 
+from ..base.errors import ShotDataError, WorkBoundError
 from ..bodies import MASS, RADIUS, Plate, Sphere
-from ..errors import ShotDataError, WorkBoundError
 from ..limits import (
     SPEED_RESOLUTION,
     SPEED_TOLERANCE,
@@ -324,7 +324,7 @@ def validate(
     (:func:`plateimpact.limits.along_speed`). Before any scene runs: :class:`ShotDataError`
     when every shot has weight 0 (nothing to score), :class:`ParameterError` for a
     tolerance or resolution out of range, and
-    :class:`~plateimpact.errors.WorkBoundError` when the shots' scenes and the boundary
+    :class:`~plateimpact.base.errors.WorkBoundError` when the shots' scenes and the boundary
     search could together pass ``max_scenes`` (None: no bound; :func:`work_estimate`).
     The shots run RUN_CHUNK at a time.
     """

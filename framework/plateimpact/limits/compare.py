@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 import attrs
 
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from .find import Limits
 from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine, unit_suffix
 from .maps import OutcomeMap

@@ -16,10 +16,10 @@ from typing import Any
 import attrs
 import numpy as np
 
+from ..base.errors import ParameterError, WorkBoundError
+from ..base.parameters import check_instance
 from ..batch import SceneBatch
 from ..bodies import MASS, RADIUS, Plate, Sphere
-from ..errors import ParameterError, WorkBoundError
-from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
@@ -259,7 +259,7 @@ def along_speed(
     ``tolerance`` [m/s], and no band ``resolution`` [m/s] wide or wider is missed
     (docs/limits.md). ``executor`` (a process pool) spreads the scan over workers.
     A scan of more than ``max_scenes`` scenes (None: no bound) is refused before any
-    scene runs (:class:`~plateimpact.errors.WorkBoundError`).
+    scene runs (:class:`~plateimpact.base.errors.WorkBoundError`).
     """
     fixed = _floats("obliquities", obliquities)
     IMPACT_OBLIQUITY.check(fixed)

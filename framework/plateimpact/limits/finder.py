@@ -34,7 +34,7 @@ from typing import NoReturn
 import attrs
 import numpy as np
 
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 
 #: Parts a bracket is cut into per pass.
 SECTIONS = 16

@@ -16,9 +16,9 @@ from concurrent.futures import Executor
 import attrs
 import numpy as np
 
+from ..base.errors import ParameterError
+from ..base.parameters import check_instance
 from ..bodies import Plate, Sphere
-from ..errors import ParameterError
-from ..parameters import check_instance
 from ..results import BatchResult
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation

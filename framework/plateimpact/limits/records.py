@@ -17,16 +17,16 @@ from typing import Any
 
 import numpy as np
 
+from ..base.errors import ArchiveError, ParameterError, PlateImpactError
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
 from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..errors import ArchiveError, ParameterError, PlateImpactError
-from ..parameters import Parameter
 from ..registry import default_registry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import git_commit, versions
 from ..storage.records import Column, Record
-from ..untrusted import printable
 from .find import Limits
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap

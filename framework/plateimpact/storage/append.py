@@ -22,12 +22,12 @@ from typing import Protocol
 import h5py
 import numpy as np
 
+from ..base.errors import ArchiveError
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
 from ..batch import CORE_COLUMNS, SceneBatch
-from ..errors import ArchiveError
-from ..parameters import Parameter
 from ..registry import default_registry
 from ..results import BatchResult
-from ..untrusted import printable
 from ..variant import Variant
 from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed

@@ -23,11 +23,11 @@ import attrs
 import h5py
 import numpy as np
 
+from ..base.errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
 from ..batch import SceneBatch
-from ..errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
-from ..parameters import Parameter
 from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
-from ..untrusted import printable
 from ..variant import Variant
 from . import append as append_module
 from . import records

@@ -15,10 +15,10 @@ from collections.abc import Iterable, Mapping
 from importlib import metadata as importlib_metadata
 from typing import Any
 
+from ..base.untrusted import printable
 from ..plugin import Plugin
 from ..registry import KINDS, plugin_origin
 from ..simulation import Simulation
-from ..untrusted import printable
 from .source_hash import module_sources, source_sha256
 
 #: The core's distribution, and the module whose imports, transitively, are the core

@@ -9,7 +9,7 @@ import json
 import h5py
 import numpy as np
 
-from ..parameters import Parameter
+from ..base.parameters import Parameter
 from ..ragged import Ragged
 
 #: Attribute holding the SHA-256 of a study's, run's or stored record's other attributes.

@@ -28,15 +28,15 @@ from typing import Any
 
 import attrs
 
+from ..base.errors import InputsError, ParameterError, PluginError, UnknownNameError
+from ..base.parameters import Parameter
+from ..base.untrusted import described, load_json_file, printable
 from ..bodies import MASS, RADIUS, Sphere
-from ..errors import InputsError, ParameterError, PluginError, UnknownNameError
 from ..model import REST_SPEED_FRACTION
-from ..parameters import Parameter
 from ..plugin import Plugin
 from ..registry import KINDS, PluginRegistry, default_registry
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
-from ..untrusted import described, load_json_file, printable
 from .plate_file import plate_from_dict
 
 FORMAT = "plateimpact-inputs-1"
@@ -198,7 +198,7 @@ class RunInputs:
 
 def read_run_inputs(data: object, source: str, registry: PluginRegistry | None = None) -> RunInputs:
     """The scene and simulation of ``run --json``'s output or of its ``inputs`` object;
-    :class:`~plateimpact.errors.InputsError` names ``source`` and the key."""
+    :class:`~plateimpact.base.errors.InputsError` names ``source`` and the key."""
     if isinstance(data, dict) and isinstance(data.get("inputs"), dict):
         data = data["inputs"]
     if not isinstance(data, dict) or data.get("format") != FORMAT:

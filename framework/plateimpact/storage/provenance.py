@@ -18,9 +18,9 @@ from typing import Any
 from urllib.parse import urlparse
 from urllib.request import url2pathname
 
+from ..base.errors import PlateImpactWarning
+from ..base.parameters import Parameter
 from ..bodies import Plate, Sphere
-from ..errors import PlateImpactWarning
-from ..parameters import Parameter
 from ..simulation import Simulation
 from ..variant import Variant
 from . import inputs

@@ -19,8 +19,8 @@ import attrs
 import h5py
 import numpy as np
 
-from ..errors import ArchiveError, ParameterError
-from ..untrusted import printable
+from ..base.errors import ArchiveError, ParameterError
+from ..base.untrusted import printable
 from .append import append_with
 from .data_files import DataFiles
 from .hdf5 import seal, write_dataset

@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING, Any
 
 import attrs
 
-from ..errors import ArchiveError, ParameterError
+from ..base.errors import ArchiveError, ParameterError
+from ..base.untrusted import load_json, printable
 from ..registry import PluginRegistry
-from ..untrusted import load_json, printable
 from ..variant import Variant
 from .append import RunExistsError, StudyDefinition, check_same_scenes
 from .code_provenance import changes, plugins_record

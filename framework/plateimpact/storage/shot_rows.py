@@ -13,9 +13,9 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
+from ..base.errors import ShotDataError
+from ..base.parameters import Parameter
 from ..bodies import MASS, RADIUS
-from ..errors import ShotDataError
-from ..parameters import Parameter
 from ..results import RESULT_FIELDS, Outcome
 from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 

@@ -8,9 +8,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..base.errors import ParameterError
 from ..batch import SceneBatch
 from ..bodies import Plate, Sphere
-from ..errors import ParameterError
 from ..results import Outcome
 from ..scene import IMPACT_SPEED
 from ..simulation import Simulation

@@ -28,7 +28,7 @@ import attrs
 import numpy as np
 from scipy import special
 
-from ..errors import ParameterError, V50Error
+from ..base.errors import ParameterError, V50Error
 
 #: The fits, by name.
 PROBIT, LOGIT = "probit", "logit"

@@ -20,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy import optimize
 
-from ..errors import V50Error
+from ..base.errors import V50Error
 from .likelihood import Estimate, GoNoGo, Link
 
 #: A maximum is accepted where |d(−log L)/dβ| <= this × the total weight (the rounds);

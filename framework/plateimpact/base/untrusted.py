@@ -4,7 +4,7 @@ Anything read from a file (an archive's attributes, a plate file, an inputs reco
 shot file, a P* table) may come from a colleague's machine or a hostile one. Two rules:
 
 * :func:`load_json` parses JSON into plain values or raises the caller's one-line
-  :class:`~plateimpact.errors.PlateImpactError`: never a ``RecursionError`` from deep
+  :class:`~plateimpact.base.errors.PlateImpactError`: never a ``RecursionError`` from deep
   nesting, never an integer too long to become a float, never a key that silently wins
   over its duplicate, never ``NaN`` (``Infinity`` is JSON's spelling of P* = inf and is
   read).
