@@ -23,7 +23,7 @@ import numpy as np
 
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
-from plateimpact.crater import crater_section
+from plateimpact.model.crater import crater_section
 from plateimpact.units import deg, mm
 from plateimpact_plugins import Hinge
 

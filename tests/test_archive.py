@@ -14,8 +14,8 @@ import pytest
 
 import plateimpact as pi
 from plateimpact.cli import main as cli
-from plateimpact.crater import crater_section
 from plateimpact.limits import stored_limits
+from plateimpact.model.crater import crater_section
 
 SPEEDS = np.linspace(150.0, 1200.0, 8)
 

@@ -19,7 +19,7 @@ from plateimpact.base.errors import WorkBoundError
 from plateimpact.calibration import pstar_plan, pstar_search
 from plateimpact.calibration.outcome_model import ProbabilityModel, ShotLines
 from plateimpact.limits import chunked
-from plateimpact.results import Outcome
+from plateimpact.model.results import Outcome
 
 PLATE = presets.plate("2024-T3/3.18")
 FAST = {"resolution": 4.0, "tolerance": 0.25}

@@ -19,11 +19,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "framework" / "plateimpact"
 LAYERS = {
-    "physics": {
-        "base", "units", "bodies", "scene", "batch", "geometry",
-        "plugin", "resistance", "failure", "binding", "model", "results", "ragged", "crater",
-        "presets",
-    },
+    "physics": {"base", "units", "model"},
     "running": {
         "dense", "dynamics", "integrator", "control", "events", "recorder", "driver",
         "hookspecs", "discovery", "registry", "simulation", "variant", "progress",

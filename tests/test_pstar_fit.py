@@ -28,7 +28,7 @@ from plateimpact.calibration.outcome_model import (
 )
 from plateimpact.calibration.pstar_search import Estimate
 from plateimpact.cli import calibrate_pstar, main
-from plateimpact.results import Outcome
+from plateimpact.model.results import Outcome
 from plateimpact.storage import output
 from plateimpact_plugins.variable_pstar import TABLE_COLUMNS, PstarTable
 

@@ -16,17 +16,17 @@ from typing import TYPE_CHECKING, Any
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
     # the model's data
-    "Sphere": "bodies",
-    "Plate": "bodies",
-    "Scene": "scene",
-    "SceneBatch": "batch",
+    "Sphere": "model.bodies",
+    "Plate": "model.bodies",
+    "Scene": "model.scene",
+    "SceneBatch": "model.batch",
     "Parameter": "base.parameters",
     "Range": "base.parameters",
     # plug-in interfaces
-    "ResistanceLaw": "resistance",
-    "BoundResistance": "resistance",
-    "contact_force": "resistance",
-    "FailureModel": "failure",
+    "ResistanceLaw": "model.resistance",
+    "BoundResistance": "model.resistance",
+    "contact_force": "model.resistance",
+    "FailureModel": "model.failure",
     "Integrator": "integrator",
     "Step": "integrator",
     "StepControl": "integrator",
@@ -34,44 +34,44 @@ _EXPORTS: dict[str, str] = {
     "MAX_STEPS": "integrator",
     "MAX_SECONDS": "integrator",
     "RTOL": "integrator",
-    "Column": "plugin",
+    "Column": "model.plugin",
     "Dynamics": "dynamics",
     "DenseOutput": "dense",
     "PolynomialDenseOutput": "dense",
     "hermite": "dense",
-    "BoundBatch": "binding",
+    "BoundBatch": "model.binding",
     "hookimpl": "hookspecs",
     "PluginRegistry": "registry",
     "default_registry": "registry",
     "load_registry": "registry",
     "BrokenPackage": "discovery",
     # the model and its events
-    "ImpactModel": "model",
-    "KINEMATIC_STATE": "model",
-    "PENETRATION": "model",
-    "LATERAL": "model",
-    "OBLIQUITY": "model",
-    "SPEED": "model",
-    "ONSET": "model",
-    "CONTACT_LOST": "model",
-    "PERFORATED": "model",
-    "AT_REST": "model",
-    "TURNED_BACK": "model",
-    "EVENT_NAMES": "model",
-    "EVENT_OUTCOMES": "model",
-    "contact_geometry": "geometry",
-    "contact_lost_margin": "geometry",
-    "force_inclination": "geometry",
+    "ImpactModel": "model.impact",
+    "KINEMATIC_STATE": "model.impact",
+    "PENETRATION": "model.impact",
+    "LATERAL": "model.impact",
+    "OBLIQUITY": "model.impact",
+    "SPEED": "model.impact",
+    "ONSET": "model.impact",
+    "CONTACT_LOST": "model.impact",
+    "PERFORATED": "model.impact",
+    "AT_REST": "model.impact",
+    "TURNED_BACK": "model.impact",
+    "EVENT_NAMES": "model.impact",
+    "EVENT_OUTCOMES": "model.impact",
+    "contact_geometry": "model.geometry",
+    "contact_lost_margin": "model.geometry",
+    "force_inclination": "model.geometry",
     # running
     "Simulation": "simulation",
     "run": "simulation",
     "Variant": "variant",
-    "Outcome": "results",
-    "Result": "results",
-    "BatchResult": "results",
-    "Trajectory": "results",
-    "CraterSection": "results",
-    "Ragged": "ragged",
+    "Outcome": "model.results",
+    "Result": "model.results",
+    "BatchResult": "model.results",
+    "Trajectory": "model.results",
+    "CraterSection": "model.results",
+    "Ragged": "model.ragged",
     # storage
     "Archive": "storage.archive",
     "load_plate_file": "storage.plate_file",
@@ -124,12 +124,12 @@ _EXPORTS: dict[str, str] = {
 }
 #: Submodules users reach as attributes (``pi.units.mm``) -> where each is.
 _SUBMODULES: dict[str, str] = {
-    "batch": "batch",
+    "batch": "model.batch",
     "calibration": "calibration",
     "experiment": "experiment",
-    "geometry": "geometry",
+    "geometry": "model.geometry",
     "limits": "limits",
-    "presets": "presets",
+    "presets": "model.presets",
     "units": "units",
     "v50": "v50",
 }
@@ -160,7 +160,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
-    from . import batch, calibration, experiment, geometry, presets, units, v50
+    from . import calibration, experiment, units, v50
     from .base.errors import (
         ArchiveError,
         ArchiveWaitWarning,
@@ -179,8 +179,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     )
     from .base.parameters import Parameter, Range
     from .base.untrusted import check_input, load_json, printable
-    from .binding import BoundBatch
-    from .bodies import Plate, Sphere
     from .calibration import (
         Calibration,
         CalibrationReport,
@@ -201,8 +199,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .discovery import BrokenPackage
     from .dynamics import Dynamics
     from .experiment import ValidationReport, validate
-    from .failure import FailureModel
-    from .geometry import contact_geometry, contact_lost_margin, force_inclination
     from .hookspecs import hookimpl
     from .integrator import (
         MAX_SECONDS,
@@ -213,7 +209,12 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         StepControl,
         StepperState,
     )
-    from .model import (
+    from .model import batch, geometry, presets
+    from .model.binding import BoundBatch
+    from .model.bodies import Plate, Sphere
+    from .model.failure import FailureModel
+    from .model.geometry import contact_geometry, contact_lost_margin, force_inclination
+    from .model.impact import (
         AT_REST,
         CONTACT_LOST,
         EVENT_NAMES,
@@ -228,12 +229,12 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         TURNED_BACK,
         ImpactModel,
     )
-    from .plugin import Column
-    from .ragged import Ragged
+    from .model.plugin import Column
+    from .model.ragged import Ragged
+    from .model.resistance import BoundResistance, ResistanceLaw, contact_force
+    from .model.results import BatchResult, CraterSection, Outcome, Result, Trajectory
+    from .model.scene import Scene
     from .registry import PluginRegistry, default_registry, load_registry
-    from .resistance import BoundResistance, ResistanceLaw, contact_force
-    from .results import BatchResult, CraterSection, Outcome, Result, Trajectory
-    from .scene import Scene
     from .simulation import Simulation, run
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file

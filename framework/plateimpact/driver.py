@@ -15,13 +15,13 @@ import time
 import numpy as np
 
 from .base.errors import IntegrationError
-from .batch import SceneBatch
-from .binding import BoundBatch
 from .control import StepSizes
 from .dynamics import Dynamics
 from .events import first_event, sample_step
 from .integrator import Integrator, StepperState
-from .model import (
+from .model.batch import SceneBatch
+from .model.binding import BoundBatch
+from .model.impact import (
     EVENT_OUTCOMES,
     KINEMATIC_STATE,
     LATERAL,
@@ -32,8 +32,8 @@ from .model import (
     TURNED_BACK,
     ImpactModel,
 )
+from .model.results import BatchResult, Outcome
 from .recorder import ResultRecorder
-from .results import BatchResult, Outcome
 
 
 def integrate(

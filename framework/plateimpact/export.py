@@ -16,9 +16,9 @@ import numpy as np
 
 from .base.errors import ParameterError
 from .base.parameters import Parameter
-from .batch import CORE_COLUMNS
+from .model.batch import CORE_COLUMNS
+from .model.results import RESULT_FIELDS, BatchResult, Outcome
 from .registry import default_registry
-from .results import RESULT_FIELDS, BatchResult, Outcome
 from .storage.append import StudyDefinition
 from .storage.archive import Archive
 from .storage.data_files import encoded

@@ -17,7 +17,7 @@ import numpy as np
 from .base.parameters import Parameter, Range
 from .dense import DenseOutput
 from .dynamics import Dynamics
-from .plugin import Plugin
+from .model.plugin import Plugin
 
 #: Per-scene arrays a stepper carries from one accepted step to the next (last axis:
 #: scenes). ``derivative`` (d, n), if present, is f(y) at the current state, which the

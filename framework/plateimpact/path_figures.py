@@ -11,8 +11,8 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
+from .model.results import Outcome
 from .plotting import FONT, PAGE_WIDTH, SMALL, figure, short_run_name, study_panels
-from .results import Outcome
 
 if TYPE_CHECKING:
     from .study import StudyResults

@@ -24,7 +24,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from .limits.regimes import REGIMES, Regime, regime_codes
-from .results import BatchResult, CraterSection, Outcome, Trajectory
+from .model.results import BatchResult, CraterSection, Outcome, Trajectory
 from .storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, write_output
 
 if TYPE_CHECKING:

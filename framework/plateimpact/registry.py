@@ -27,7 +27,6 @@ from .base.errors import (
     UnknownNameError,
 )
 from .base.parameters import Parameter
-from .batch import CORE_COLUMNS
 from .discovery import (
     BrokenPackage,
     PluginOrigin,
@@ -37,10 +36,11 @@ from .discovery import (
     first_line,
     installed_entry_points,
 )
-from .failure import FailureModel
 from .integrator import Integrator
-from .plugin import Plugin
-from .resistance import ResistanceLaw
+from .model.batch import CORE_COLUMNS
+from .model.failure import FailureModel
+from .model.plugin import Plugin
+from .model.resistance import ResistanceLaw
 
 #: The kinds of plug-in, by the word users and the CLI use for them (the model's slots).
 KINDS: dict[str, type[Plugin]] = {

@@ -10,15 +10,15 @@ import attrs
 import numpy as np
 
 from .base.errors import ParameterError, PluginError
-from .batch import SceneBatch, check_chunk_size
-from .crater import crater_sections
 from .driver import integrate
 from .integrator import Integrator
-from .model import REST_SPEED_FRACTION, ImpactModel
+from .model.batch import SceneBatch, check_chunk_size
+from .model.crater import crater_sections
+from .model.impact import REST_SPEED_FRACTION, ImpactModel
+from .model.results import BatchResult, Result
+from .model.scene import Scene
 from .progress import report_scenes
 from .registry import PluginRegistry, default_registry
-from .results import BatchResult, Result
-from .scene import Scene
 
 #: The plug-ins a model uses unless told otherwise (the report's model).
 DEFAULT_RESISTANCE = "poncelet"

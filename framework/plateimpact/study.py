@@ -12,15 +12,15 @@ from typing import TYPE_CHECKING
 import attrs
 import numpy as np
 
-from . import presets
 from .base.errors import ArchiveWaitWarning, ParameterError, UnknownNameError
-from .batch import SceneBatch, check_chunk_size
-from .bodies import Plate, Sphere
 from .comparison.ranges import Comparison
+from .model import presets
+from .model.batch import SceneBatch, check_chunk_size
+from .model.bodies import Plate, Sphere
+from .model.results import BatchResult
+from .model.scene import Scene
 from .progress import progress_bar
 from .registry import PluginRegistry
-from .results import BatchResult
-from .scene import Scene
 from .simulation import DEFAULT_CHUNK_SIZE, run_chunk
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError

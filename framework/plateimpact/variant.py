@@ -11,7 +11,7 @@ import numpy as np
 
 from .base.errors import ParameterError
 from .base.untrusted import load_json
-from .model import REST_SPEED_FRACTION
+from .model.impact import REST_SPEED_FRACTION
 from .registry import PluginRegistry
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 

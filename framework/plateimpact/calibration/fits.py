@@ -10,8 +10,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
-from ..bodies import Plate, Sphere
-from ..presets import DEFAULT_SPHERE
+from ..model.bodies import Plate, Sphere
+from ..model.presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri

@@ -16,13 +16,13 @@ import attrs
 import numpy as np
 
 from ..base.errors import ParameterError
-from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
 from ..limits import locate, regime_codes
 from ..limits.chunked import run_chunked
 from ..limits.finder import RELATIVE_FLOOR
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
+from ..model.batch import SceneBatch
+from ..model.bodies import Plate, Sphere
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
 from ..simulation import Simulation
 from .outcome_model import Bands, ShotLines
 

@@ -27,8 +27,8 @@ from scipy.optimize import minimize_scalar
 from scipy.special import ndtr, ndtri
 
 from ..base.errors import ParameterError
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
 
 #: The speed scatter s [m/s] unless given: about 2-3 % of the report's ballistic limits.
 SPEED_SIGMA = 10.0

@@ -14,9 +14,9 @@ import attrs
 import numpy as np
 
 from ..base.errors import CalibrationError, ConvergenceError
-from ..bodies import Plate, Sphere
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
-from ..presets import DEFAULT_SPHERE
+from ..model.bodies import Plate, Sphere
+from ..model.presets import DEFAULT_SPHERE
 from ..simulation import Simulation
 from ..storage.shots import Shots
 from .model_lines import Cost, LineModel, check_finder

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..base.errors import WorkBoundError
-from ..results import Outcome
+from ..model.results import Outcome
 from .outcome_model import ShotLines
 from .pstar_search import ALPHA_FIT_EVALUATIONS, SCAN_POINTS, scan_scenes
 

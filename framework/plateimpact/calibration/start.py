@@ -11,11 +11,11 @@ from scipy.integrate import quad
 
 from ..base.errors import CalibrationError, ShotDataError
 from ..base.parameters import Range
-from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
-from ..geometry import contact_geometry
 from ..limits.chunked import run_chunked
-from ..results import Outcome
+from ..model.batch import SceneBatch
+from ..model.bodies import Plate, Sphere
+from ..model.geometry import contact_geometry
+from ..model.results import Outcome
 from ..simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri

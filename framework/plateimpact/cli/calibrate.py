@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..base.units import g, mm
-from ..bodies import Plate, Sphere
 from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
 from ..calibration.pstar_plan import MAX_FIT_SCENES
+from ..model.bodies import Plate, Sphere
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..simulation import Simulation

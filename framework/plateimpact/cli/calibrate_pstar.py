@@ -10,7 +10,6 @@ import os
 from typing import Any
 
 from ..base.units import g, mm
-from ..bodies import Plate, Sphere
 from ..calibration.model_lines import Cost, check_finder
 from ..calibration.outcome_model import (
     OUTCOME_BLUNDER,
@@ -27,6 +26,7 @@ from ..calibration.pstar import (
 from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, Estimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
+from ..model.bodies import Plate, Sphere
 from ..progress import reporting_scenes
 from ..simulation import Simulation
 from ..storage.plate_file import plate_file_text

@@ -17,9 +17,9 @@ import numpy as np
 
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
-from ..batch import CORE_COLUMNS, SceneBatch
+from ..model.batch import CORE_COLUMNS, SceneBatch
+from ..model.results import BatchResult
 from ..registry import KINDS, default_registry
-from ..results import BatchResult
 from ..storage.archive import Archive
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.

@@ -8,9 +8,9 @@ import inspect
 import json
 from typing import Any
 
-from .. import presets
 from ..base.parameters import Parameter
-from ..bodies import MASS, RADIUS, THICKNESS
+from ..model import presets
+from ..model.bodies import MASS, RADIUS, THICKNESS
 from ..registry import KINDS, PluginRegistry, default_registry
 from .common import say
 from .describe import shown

@@ -13,9 +13,9 @@ import numpy as np
 
 from .. import limits as lim
 from ..base.errors import ArchiveError
+from ..model.results import Outcome
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
-from ..results import Outcome
 from ..storage.archive import Archive
 from ..storage.together import write_together
 from .common import (

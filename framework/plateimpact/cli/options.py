@@ -16,13 +16,13 @@ from typing import Any
 
 import attrs
 
-from .. import presets
 from ..base.parameters import Parameter, json_literal
 from ..base.untrusted import load_json
-from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..model import REST_SPEED_FRACTION, ImpactModel
+from ..model import presets
+from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from ..model.impact import REST_SPEED_FRACTION, ImpactModel
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..registry import KINDS, PluginRegistry, default_registry
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 from ..storage.plate_file import load_plate_file
 from .common import UsageError

@@ -9,12 +9,12 @@ from typing import Any
 import numpy as np
 
 from ..base.parameters import Parameter
-from ..bodies import Plate, Sphere
-from ..crater import crater_section
+from ..model.bodies import Plate, Sphere
+from ..model.crater import crater_section
+from ..model.results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry, default_registry
-from ..results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
 from ..storage.inputs import load_run_inputs
 from ..storage.provenance import inputs_record

@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import limits as lim
 from ..base.errors import V50Error
-from ..bodies import Sphere
+from ..model.bodies import Sphere
 from ..progress import reporting_scenes
 from ..registry import PluginRegistry
 from ..storage.shots import Shots

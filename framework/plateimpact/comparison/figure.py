@@ -8,8 +8,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from ..limits.lines import SPEED
+from ..model.results import Outcome
 from ..plotting import figure
-from ..results import Outcome
 from .ranges import Comparison, ComparisonRow
 
 #: Shades of the ranges whose outcome differs, one per change (A's regime -> B's).

@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..base.errors import ShotDataError
-from ..batch import SceneBatch
+from ..model.batch import SceneBatch
 from ..plotting import (
     FONT,
     MAX_COLUMNS,

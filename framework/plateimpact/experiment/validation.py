@@ -23,7 +23,6 @@ import attrs
 import numpy as np
 
 from ..base.errors import ShotDataError, WorkBoundError
-from ..bodies import MASS, RADIUS, Plate, Sphere
 from ..limits import (
     SPEED_RESOLUTION,
     SPEED_TOLERANCE,
@@ -34,8 +33,9 @@ from ..limits import (
 )
 from ..limits.chunked import run_chunked
 from ..limits.find import check_steps
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
+from ..model.bodies import MASS, RADIUS, Plate, Sphere
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
 from ..simulation import Simulation
 from ..storage.plate_file import plate_to_dict
 from ..storage.shots import Shots

@@ -13,8 +13,8 @@ from concurrent.futures import Executor
 
 import numpy as np
 
-from ..batch import SceneBatch
-from ..results import BatchResult
+from ..model.batch import SceneBatch
+from ..model.results import BatchResult
 from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
 
 #: Scenes run in one batch: numpy's per-step overhead is spread over this many already

@@ -18,10 +18,10 @@ import numpy as np
 
 from ..base.errors import ParameterError, WorkBoundError
 from ..base.parameters import check_instance
-from ..batch import SceneBatch
-from ..bodies import MASS, RADIUS, Plate, Sphere
-from ..results import BatchResult
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..model.batch import SceneBatch
+from ..model.bodies import MASS, RADIUS, Plate, Sphere
+from ..model.results import BatchResult
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
 from ..storage.code_provenance import limits_record, plugins_record
 from ..storage.plate_file import plate_to_dict

@@ -18,9 +18,9 @@ import numpy as np
 
 from ..base.errors import ParameterError
 from ..base.parameters import check_instance
-from ..bodies import Plate, Sphere
-from ..results import BatchResult
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..model.bodies import Plate, Sphere
+from ..model.results import BatchResult
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..simulation import Simulation
 from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, check_steps
 from .finder import RELATIVE_FLOOR, finest_tolerance, scan_points

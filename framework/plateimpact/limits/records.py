@@ -20,7 +20,7 @@ import numpy as np
 from ..base.errors import ArchiveError, ParameterError, PlateImpactError
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
-from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
 from ..registry import default_registry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive

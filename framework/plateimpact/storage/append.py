@@ -25,9 +25,9 @@ import numpy as np
 from ..base.errors import ArchiveError
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
-from ..batch import CORE_COLUMNS, SceneBatch
+from ..model.batch import CORE_COLUMNS, SceneBatch
+from ..model.results import BatchResult
 from ..registry import default_registry
-from ..results import BatchResult
 from ..variant import Variant
 from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed

@@ -26,8 +26,8 @@ import numpy as np
 from ..base.errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
-from ..batch import SceneBatch
-from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from ..model.batch import SceneBatch
+from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
 from ..variant import Variant
 from . import append as append_module
 from . import records

@@ -16,7 +16,7 @@ from importlib import metadata as importlib_metadata
 from typing import Any
 
 from ..base.untrusted import printable
-from ..plugin import Plugin
+from ..model.plugin import Plugin
 from ..registry import KINDS, plugin_origin
 from ..simulation import Simulation
 from .source_hash import module_sources, source_sha256

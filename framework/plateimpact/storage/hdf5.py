@@ -10,7 +10,7 @@ import h5py
 import numpy as np
 
 from ..base.parameters import Parameter
-from ..ragged import Ragged
+from ..model.ragged import Ragged
 
 #: Attribute holding the SHA-256 of a study's, run's or stored record's other attributes.
 SEAL = "attributes_sha256"

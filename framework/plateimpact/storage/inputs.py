@@ -31,11 +31,11 @@ import attrs
 from ..base.errors import InputsError, ParameterError, PluginError, UnknownNameError
 from ..base.parameters import Parameter
 from ..base.untrusted import described, load_json_file, printable
-from ..bodies import MASS, RADIUS, Sphere
-from ..model import REST_SPEED_FRACTION
-from ..plugin import Plugin
+from ..model.bodies import MASS, RADIUS, Sphere
+from ..model.impact import REST_SPEED_FRACTION
+from ..model.plugin import Plugin
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..registry import KINDS, PluginRegistry, default_registry
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..simulation import Simulation
 from .plate_file import plate_from_dict
 

@@ -24,8 +24,8 @@ import numpy as np
 from ..base.errors import ArchiveError
 from ..base.parameters import Parameter
 from ..base.untrusted import load_json
-from ..ragged import Ragged
-from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from ..model.ragged import Ragged
+from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
 from .hdf5 import digest
 
 SCENE, SAMPLE, POINT = "scene", "trajectory_sample", "crater_point"

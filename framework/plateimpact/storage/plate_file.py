@@ -22,7 +22,7 @@ from typing import Any
 from ..base.errors import ParameterError, PlateFileError
 from ..base.parameters import Parameter
 from ..base.untrusted import described, load_json_file, printable
-from ..bodies import THICKNESS, Plate
+from ..model.bodies import THICKNESS, Plate
 from ..registry import PluginRegistry, default_registry
 from .output import write_text
 

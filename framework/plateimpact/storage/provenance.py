@@ -20,7 +20,7 @@ from urllib.request import url2pathname
 
 from ..base.errors import PlateImpactWarning
 from ..base.parameters import Parameter
-from ..bodies import Plate, Sphere
+from ..model.bodies import Plate, Sphere
 from ..simulation import Simulation
 from ..variant import Variant
 from . import inputs

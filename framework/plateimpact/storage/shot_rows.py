@@ -15,9 +15,9 @@ import numpy as np
 
 from ..base.errors import ShotDataError
 from ..base.parameters import Parameter
-from ..bodies import MASS, RADIUS
-from ..results import RESULT_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..model.bodies import MASS, RADIUS
+from ..model.results import RESULT_FIELDS, Outcome
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 
 RESIDUAL_SPEED = Parameter(
     "residual_speed",

@@ -32,10 +32,10 @@ import numpy as np
 from ..base.errors import ParameterError, ShotDataError
 from ..base.parameters import Parameter
 from ..base.untrusted import check_input, spreadsheet_safe
-from ..batch import SceneBatch
-from ..bodies import MASS, RADIUS, Plate, Sphere, check_density
-from ..results import RESULT_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY
+from ..model.batch import SceneBatch
+from ..model.bodies import MASS, RADIUS, Plate, Sphere, check_density
+from ..model.results import RESULT_FIELDS, Outcome
+from ..model.scene import IMPACT_OBLIQUITY
 from .shot_reader import (
     MAX_SHOTS,
     ShotColumns,
@@ -71,7 +71,7 @@ class Shots:
     Attributes
     ----------
     impact_speed : numpy.ndarray
-        Vs [m/s], in the range of :data:`~plateimpact.scene.IMPACT_SPEED`.
+        Vs [m/s], in the range of :data:`~plateimpact.model.scene.IMPACT_SPEED`.
     impact_obliquity : numpy.ndarray
         θs [rad], in [0, π/2).
     residual_speed : numpy.ndarray

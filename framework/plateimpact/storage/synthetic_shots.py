@@ -9,10 +9,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..base.errors import ParameterError
-from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
+from ..model.batch import SceneBatch
+from ..model.bodies import Plate, Sphere
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
 from ..simulation import Simulation
 from .shots import Shots
 

@@ -9,8 +9,8 @@ thickness. Table 1 prints it under 2024-T3, but Figures 11–17 and 35 name it 6
 
 from __future__ import annotations
 
-from .base.errors import UnknownNameError
-from .base.units import deg, mm
+from ..base.errors import UnknownNameError
+from ..base.units import deg, mm
 from .bodies import Plate, Sphere
 
 #: Density of the SAE 52100 sphere [kg/m³] (not in the report; a handbook value).

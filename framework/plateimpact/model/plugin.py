@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import attrs
 
-from .base.parameters import Parameter, declared_settings
+from ..base.parameters import Parameter, declared_settings
 
 
 @attrs.frozen

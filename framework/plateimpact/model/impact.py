@@ -8,8 +8,8 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from .base.errors import ParameterError, PluginError
-from .base.parameters import Parameter, Range
+from ..base.errors import ParameterError, PluginError
+from ..base.parameters import Parameter, Range
 from .batch import CORE_COLUMNS, SceneBatch
 from .binding import BoundBatch
 from .failure import FailureModel

@@ -6,7 +6,7 @@ import math
 
 import attrs
 
-from .base.parameters import Parameter, Range, check_instance
+from ..base.parameters import Parameter, Range, check_instance
 from .bodies import Plate, Sphere
 
 # From the speed of an indentation test (1 mm/s: the strength term a alone) to 10 km/s,

@@ -31,7 +31,7 @@ class FailureModel(Plugin, ABC):
     not change during the impact belong in :meth:`prepare`, which runs once per batch.
     ``batch`` arguments are this model's view of the scenes (core columns, its plate
     constants, its prepared columns); ``law`` is the model's resistance law on its own
-    view (:class:`~plateimpact.resistance.BoundResistance`).
+    view (:class:`~plateimpact.model.resistance.BoundResistance`).
 
     **Failure state.** A model whose failure evolves (the hinge's finger angle β) names
     its variables in ``state_names``; the integrator then carries them per scene as an

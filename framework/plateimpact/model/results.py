@@ -8,7 +8,7 @@ import math
 import attrs
 import numpy as np
 
-from .base.parameters import Parameter
+from ..base.parameters import Parameter
 from .ragged import Ragged
 
 _DEG, _MM = math.pi / 180.0, 1e-3
@@ -230,7 +230,7 @@ class BatchResult:
     """Results of a batch as arrays (one entry per scene, in the batch's order).
 
     ``trajectory`` (when recorded) and ``craters`` (when asked for) are
-    :class:`~plateimpact.ragged.Ragged` arrays with one row per scene: the trajectory's
+    :class:`~plateimpact.model.ragged.Ragged` arrays with one row per scene: the trajectory's
     columns are :data:`TRAJECTORY_FIELDS` then ``failure_<state>``; the craters' are
     ``lateral`` and ``depth`` per point and ``impact_point`` per scene
     (:data:`CRATER_FIELDS`). ``stats`` counts the integrator's work.

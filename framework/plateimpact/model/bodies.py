@@ -12,8 +12,8 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .base.errors import ParameterError
-from .base.parameters import Parameter, Range
+from ..base.errors import ParameterError
+from ..base.parameters import Parameter, Range
 
 # The domain (docs/robustness.md, "the input domain"): spheres from a micrometre (fine
 # powder) to a metre; densities of solids that stay rigid, from balsa to past osmium,

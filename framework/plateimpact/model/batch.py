@@ -1,6 +1,6 @@
 """A batch of scenes as columns of numpy arrays: what integrators and plug-ins work on.
 
-Plug-ins never see :class:`~plateimpact.scene.Scene` objects inside the step loop; they
+Plug-ins never see :class:`~plateimpact.model.scene.Scene` objects inside the step loop; they
 see a :class:`SceneBatch`, whose columns are arrays with one entry per scene.
 """
 
@@ -11,8 +11,8 @@ from collections.abc import Iterable, Iterator, Mapping
 
 import numpy as np
 
-from .base.errors import ParameterError
-from .base.parameters import Parameter, check_instance
+from ..base.errors import ParameterError
+from ..base.parameters import Parameter, check_instance
 from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere, check_density
 from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 
@@ -73,7 +73,7 @@ class SceneBatch:
 
     Columns are read as attributes (``batch.radius``): :data:`CORE_COLUMNS`, then the
     plate constants. Inside the step loop a plug-in sees its own view of the bound batch
-    (:class:`~plateimpact.binding.BoundBatch`): the core columns, the plate constants it
+    (:class:`~plateimpact.model.binding.BoundBatch`): the core columns, the plate constants it
     declared and the per-scene columns it prepared.
     """
 
