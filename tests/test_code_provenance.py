@@ -241,7 +241,11 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
     assert record["integrator"]["class"] == "plateimpact_plugins.segment.Segment"
     assert record["integrator"]["distribution"] == "plateimpact"
     core = record["core"]["source_modules"]
-    assert {"plateimpact.simulation", "plateimpact.model.impact", "plateimpact.driver"} <= set(core)
+    assert {
+        "plateimpact.simulation",
+        "plateimpact.model.impact",
+        "plateimpact.solve.driver",
+    } <= set(core)
     assert not any(m.startswith(("plateimpact.cli", "plateimpact.storage")) for m in core)
     # run --json (and so sweep's FILE.json) and the archive's run attribute.
     argv = ["run", "--preset", "2024-T3/3.18", "--speed", "640", "--obliquity", "60"]

@@ -21,8 +21,7 @@ CORE = ROOT / "framework" / "plateimpact"
 LAYERS = {
     "physics": {"base", "units", "model"},
     "running": {
-        "dense", "dynamics", "integrator", "control", "events", "recorder", "driver",
-        "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
+        "solve", "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
     },
     "storage": {"storage"},
     "analysis": {

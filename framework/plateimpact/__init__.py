@@ -27,18 +27,18 @@ _EXPORTS: dict[str, str] = {
     "BoundResistance": "model.resistance",
     "contact_force": "model.resistance",
     "FailureModel": "model.failure",
-    "Integrator": "integrator",
-    "Step": "integrator",
-    "StepControl": "integrator",
-    "StepperState": "integrator",
-    "MAX_STEPS": "integrator",
-    "MAX_SECONDS": "integrator",
-    "RTOL": "integrator",
+    "Integrator": "solve.integrator",
+    "Step": "solve.integrator",
+    "StepControl": "solve.integrator",
+    "StepperState": "solve.integrator",
+    "MAX_STEPS": "solve.integrator",
+    "MAX_SECONDS": "solve.integrator",
+    "RTOL": "solve.integrator",
     "Column": "model.plugin",
-    "Dynamics": "dynamics",
-    "DenseOutput": "dense",
-    "PolynomialDenseOutput": "dense",
-    "hermite": "dense",
+    "Dynamics": "solve.dynamics",
+    "DenseOutput": "solve.dense",
+    "PolynomialDenseOutput": "solve.dense",
+    "hermite": "solve.dense",
     "BoundBatch": "model.binding",
     "hookimpl": "hookspecs",
     "PluginRegistry": "registry",
@@ -195,20 +195,9 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         newton_fit,
     )
     from .comparison import Comparison
-    from .dense import DenseOutput, PolynomialDenseOutput, hermite
     from .discovery import BrokenPackage
-    from .dynamics import Dynamics
     from .experiment import ValidationReport, validate
     from .hookspecs import hookimpl
-    from .integrator import (
-        MAX_SECONDS,
-        MAX_STEPS,
-        RTOL,
-        Integrator,
-        Step,
-        StepControl,
-        StepperState,
-    )
     from .model import batch, geometry, presets
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
@@ -236,6 +225,17 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .model.scene import Scene
     from .registry import PluginRegistry, default_registry, load_registry
     from .simulation import Simulation, run
+    from .solve.dense import DenseOutput, PolynomialDenseOutput, hermite
+    from .solve.dynamics import Dynamics
+    from .solve.integrator import (
+        MAX_SECONDS,
+        MAX_STEPS,
+        RTOL,
+        Integrator,
+        Step,
+        StepControl,
+        StepperState,
+    )
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file
     from .storage.shots import Shots

@@ -36,11 +36,11 @@ from .discovery import (
     first_line,
     installed_entry_points,
 )
-from .integrator import Integrator
 from .model.batch import CORE_COLUMNS
 from .model.failure import FailureModel
 from .model.plugin import Plugin
 from .model.resistance import ResistanceLaw
+from .solve.integrator import Integrator
 
 #: The kinds of plug-in, by the word users and the CLI use for them (the model's slots).
 KINDS: dict[str, type[Plugin]] = {

@@ -10,8 +10,6 @@ import attrs
 import numpy as np
 
 from .base.errors import ParameterError, PluginError
-from .driver import integrate
-from .integrator import Integrator
 from .model.batch import SceneBatch, check_chunk_size
 from .model.crater import crater_sections
 from .model.impact import REST_SPEED_FRACTION, ImpactModel
@@ -19,6 +17,8 @@ from .model.results import BatchResult, Result
 from .model.scene import Scene
 from .progress import report_scenes
 from .registry import PluginRegistry, default_registry
+from .solve.driver import integrate
+from .solve.integrator import Integrator
 
 #: The plug-ins a model uses unless told otherwise (the report's model).
 DEFAULT_RESISTANCE = "poncelet"

@@ -51,7 +51,7 @@ LIMITS: dict[str, Callable[[ModuleType, float], None]] = {
     "plateimpact.storage.archive": _archive,
     "plateimpact.progress": _progress,
     "plateimpact.storage.provenance": _provenance,
-    "plateimpact.integrator": _integrator,
+    "plateimpact.solve.integrator": _integrator,
 }
 
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model.impact import KINEMATIC_STATE
-from .model.ragged import Ragged
-from .model.results import RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
+from ..model.impact import KINEMATIC_STATE
+from ..model.ragged import Ragged
+from ..model.results import RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
 
 
 class ResultRecorder:

@@ -6,8 +6,8 @@ from typing import Any
 
 import numpy as np
 
-from .model.binding import BoundBatch
-from .model.impact import LATERAL, PENETRATION, SPEED, ImpactModel
+from ..model.binding import BoundBatch
+from ..model.impact import LATERAL, PENETRATION, SPEED, ImpactModel
 
 
 class Dynamics:

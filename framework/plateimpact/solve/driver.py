@@ -4,7 +4,7 @@ The driver owns what all integrators share (the scipy ``solve_ivp`` / diffrax sp
 binding the batch, step-size control, the events and their order (one definition, the
 model's event margins), failure onset, the θ = π hold, rest, the maximum penetration,
 recording, and dropping finished scenes. The integrator only steps
-(:class:`~plateimpact.integrator.Integrator`).
+(:class:`~plateimpact.solve.integrator.Integrator`).
 """
 
 from __future__ import annotations
@@ -14,14 +14,10 @@ import time
 
 import numpy as np
 
-from .base.errors import IntegrationError
-from .control import StepSizes
-from .dynamics import Dynamics
-from .events import first_event, sample_step
-from .integrator import Integrator, StepperState
-from .model.batch import SceneBatch
-from .model.binding import BoundBatch
-from .model.impact import (
+from ..base.errors import IntegrationError
+from ..model.batch import SceneBatch
+from ..model.binding import BoundBatch
+from ..model.impact import (
     EVENT_OUTCOMES,
     KINEMATIC_STATE,
     LATERAL,
@@ -32,7 +28,11 @@ from .model.impact import (
     TURNED_BACK,
     ImpactModel,
 )
-from .model.results import BatchResult, Outcome
+from ..model.results import BatchResult, Outcome
+from .control import StepSizes
+from .dynamics import Dynamics
+from .events import first_event, sample_step
+from .integrator import Integrator, StepperState
 from .recorder import ResultRecorder
 
 

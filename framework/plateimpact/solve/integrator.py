@@ -1,6 +1,6 @@
 """The Integrator interface: a stepper that the core driver runs.
 
-The driver (:mod:`plateimpact.driver`) owns everything integrators share: binding the
+The driver (:mod:`plateimpact.solve.driver`) owns everything integrators share: binding the
 batch, the events and their order, failure onset, the θ = π hold, rest, recording,
 dropping finished scenes, step-size control. An integrator supplies only what is its
 own: its first step, one step of the active scenes (with its error estimate, if it has
@@ -14,10 +14,10 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
-from .base.parameters import Parameter, Range
+from ..base.parameters import Parameter, Range
+from ..model.plugin import Plugin
 from .dense import DenseOutput
 from .dynamics import Dynamics
-from .model.plugin import Plugin
 
 #: Per-scene arrays a stepper carries from one accepted step to the next (last axis:
 #: scenes). ``derivative`` (d, n), if present, is f(y) at the current state, which the

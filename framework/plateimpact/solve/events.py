@@ -7,9 +7,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..model.impact import OBLIQUITY
 from .dense import DenseOutput
 from .dynamics import Dynamics
-from .model.impact import OBLIQUITY
 
 MAX_ROOT_ITERATIONS = 16  # Illinois converges superlinearly; more only chases rounding
 ROOT_TOLERANCE = 1e-13  # event time to this fraction of the step
