@@ -21,7 +21,7 @@ CORE = ROOT / "framework" / "plateimpact"
 LAYERS = {
     "physics": {"base", "units", "model"},
     "running": {
-        "solve", "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
+        "solve", "registry", "simulation", "variant", "progress",
     },
     "storage": {"storage"},
     "analysis": {

@@ -40,11 +40,11 @@ _EXPORTS: dict[str, str] = {
     "PolynomialDenseOutput": "solve.dense",
     "hermite": "solve.dense",
     "BoundBatch": "model.binding",
-    "hookimpl": "hookspecs",
-    "PluginRegistry": "registry",
-    "default_registry": "registry",
-    "load_registry": "registry",
-    "BrokenPackage": "discovery",
+    "hookimpl": "registry.hookspecs",
+    "PluginRegistry": "registry.plugin_registry",
+    "default_registry": "registry.plugin_registry",
+    "load_registry": "registry.plugin_registry",
+    "BrokenPackage": "registry.discovery",
     # the model and its events
     "ImpactModel": "model.impact",
     "KINEMATIC_STATE": "model.impact",
@@ -195,9 +195,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         newton_fit,
     )
     from .comparison import Comparison
-    from .discovery import BrokenPackage
     from .experiment import ValidationReport, validate
-    from .hookspecs import hookimpl
     from .model import batch, geometry, presets
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
@@ -223,7 +221,9 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .model.resistance import BoundResistance, ResistanceLaw, contact_force
     from .model.results import BatchResult, CraterSection, Outcome, Result, Trajectory
     from .model.scene import Scene
-    from .registry import PluginRegistry, default_registry, load_registry
+    from .registry.discovery import BrokenPackage
+    from .registry.hookspecs import hookimpl
+    from .registry.plugin_registry import PluginRegistry, default_registry, load_registry
     from .simulation import Simulation, run
     from .solve.dense import DenseOutput, PolynomialDenseOutput, hermite
     from .solve.dynamics import Dynamics

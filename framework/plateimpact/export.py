@@ -18,7 +18,7 @@ from .base.errors import ParameterError
 from .base.parameters import Parameter
 from .model.batch import CORE_COLUMNS
 from .model.results import RESULT_FIELDS, BatchResult, Outcome
-from .registry import default_registry
+from .registry.plugin_registry import default_registry
 from .storage.append import StudyDefinition
 from .storage.archive import Archive
 from .storage.data_files import encoded

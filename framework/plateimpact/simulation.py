@@ -16,7 +16,7 @@ from .model.impact import REST_SPEED_FRACTION, ImpactModel
 from .model.results import BatchResult, Result
 from .model.scene import Scene
 from .progress import report_scenes
-from .registry import PluginRegistry, default_registry
+from .registry.plugin_registry import PluginRegistry, default_registry
 from .solve.driver import integrate
 from .solve.integrator import Integrator
 

@@ -20,7 +20,7 @@ from .model.bodies import Plate, Sphere
 from .model.results import BatchResult
 from .model.scene import Scene
 from .progress import progress_bar
-from .registry import PluginRegistry
+from .registry.plugin_registry import PluginRegistry
 from .simulation import DEFAULT_CHUNK_SIZE, run_chunk
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError

@@ -12,7 +12,7 @@ import numpy as np
 from .base.errors import ParameterError
 from .base.untrusted import load_json
 from .model.impact import REST_SPEED_FRACTION
-from .registry import PluginRegistry
+from .registry.plugin_registry import PluginRegistry
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 
 

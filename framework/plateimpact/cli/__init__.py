@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 from ..base.errors import ParameterError, PlateImpactError, PluginError
 from ..base.untrusted import printable
-from ..registry import KINDS, PluginRegistry, default_registry
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from ..storage.provenance import versions
 from . import (
     archive_commands,

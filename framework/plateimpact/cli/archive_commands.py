@@ -11,14 +11,14 @@ from typing import Any
 
 from ..base.errors import ArchiveError, PluginError
 from ..base.untrusted import printable
-from ..discovery import (
+from ..progress import progress_bar
+from ..registry.discovery import (
     BrokenPackage,
     distribution_label,
     entry_point_label,
     first_line,
     installed_entry_points,
 )
-from ..progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths

@@ -16,7 +16,7 @@ from ..calibration import Calibration, CalibrationReport, calibrate, model_resid
 from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..model.bodies import Plate, Sphere
 from ..progress import reporting_scenes
-from ..registry import PluginRegistry
+from ..registry.plugin_registry import PluginRegistry
 from ..simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.provenance import versions

@@ -19,7 +19,7 @@ from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.batch import CORE_COLUMNS, SceneBatch
 from ..model.results import BatchResult
-from ..registry import KINDS, default_registry
+from ..registry.plugin_registry import KINDS, default_registry
 from ..storage.archive import Archive
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.

@@ -11,7 +11,7 @@ from typing import Any
 from ..base.parameters import Parameter
 from ..model import presets
 from ..model.bodies import MASS, RADIUS, THICKNESS
-from ..registry import KINDS, PluginRegistry, default_registry
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from .common import say
 from .describe import shown
 

@@ -15,7 +15,7 @@ from .. import limits as lim
 from ..base.errors import ArchiveError
 from ..model.results import Outcome
 from ..progress import reporting_scenes
-from ..registry import PluginRegistry
+from ..registry.plugin_registry import PluginRegistry
 from ..storage.archive import Archive
 from ..storage.together import write_together
 from .common import (

@@ -20,7 +20,7 @@ from typing import Protocol, TextIO
 
 from ..base.errors import PlateImpactWarning
 from ..base.untrusted import printable
-from ..discovery import first_line
+from ..registry.discovery import first_line
 from ..storage.provenance import versions
 
 

@@ -21,7 +21,7 @@ from ..base.errors import ArchiveError, ParameterError, PlateImpactError
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..registry import default_registry
+from ..registry.plugin_registry import default_registry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict

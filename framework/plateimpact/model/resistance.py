@@ -20,7 +20,7 @@ class ResistanceLaw(Plugin, ABC):
 
     To write one: subclass, set ``name``, declare the plate constants it reads in
     ``plate_constants``, implement :meth:`stress` on arrays, and register the class from
-    a ``plateimpact_register`` hook (:mod:`plateimpact.hookspecs`). Settings are attrs
+    a ``plateimpact_register`` hook (:mod:`plateimpact.registry.hookspecs`). Settings are attrs
     fields. ``stress`` runs inside the step loop: numpy only, no Python loop over
     scenes, no hook calls.
     """

@@ -17,7 +17,7 @@ from typing import Any
 
 from ..base.untrusted import printable
 from ..model.plugin import Plugin
-from ..registry import KINDS, plugin_origin
+from ..registry.plugin_registry import KINDS, plugin_origin
 from ..simulation import Simulation
 from .source_hash import module_sources, source_sha256
 

@@ -35,7 +35,7 @@ from ..model.bodies import MASS, RADIUS, Sphere
 from ..model.impact import REST_SPEED_FRACTION
 from ..model.plugin import Plugin
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
-from ..registry import KINDS, PluginRegistry, default_registry
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from ..simulation import Simulation
 from .plate_file import plate_from_dict
 

@@ -23,7 +23,7 @@ from ..base.errors import ParameterError, PlateFileError
 from ..base.parameters import Parameter
 from ..base.untrusted import described, load_json_file, printable
 from ..model.bodies import THICKNESS, Plate
-from ..registry import PluginRegistry, default_registry
+from ..registry.plugin_registry import PluginRegistry, default_registry
 from .output import write_text
 
 FORMAT = "plateimpact-plate-1"

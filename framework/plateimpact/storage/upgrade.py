@@ -26,7 +26,7 @@ import h5py
 
 from ..base.errors import ArchiveError
 from ..base.untrusted import printable
-from ..registry import default_registry
+from ..registry.plugin_registry import default_registry
 from . import stored_attributes as typed
 from .append import FORMAT, FORMAT_VERSION, add_run
 from .archive import WAIT, Archive

@@ -18,15 +18,20 @@ from typing import Any
 
 import pluggy
 
-from . import hookspecs
-from .base.errors import (
+from ..base.errors import (
     ParameterError,
     PlateImpactError,
     PluginError,
     PluginLoadWarning,
     UnknownNameError,
 )
-from .base.parameters import Parameter
+from ..base.parameters import Parameter
+from ..model.batch import CORE_COLUMNS
+from ..model.failure import FailureModel
+from ..model.plugin import Plugin
+from ..model.resistance import ResistanceLaw
+from ..solve.integrator import Integrator
+from . import hookspecs
 from .discovery import (
     BrokenPackage,
     PluginOrigin,
@@ -36,11 +41,6 @@ from .discovery import (
     first_line,
     installed_entry_points,
 )
-from .model.batch import CORE_COLUMNS
-from .model.failure import FailureModel
-from .model.plugin import Plugin
-from .model.resistance import ResistanceLaw
-from .solve.integrator import Integrator
 
 #: The kinds of plug-in, by the word users and the CLI use for them (the model's slots).
 KINDS: dict[str, type[Plugin]] = {
