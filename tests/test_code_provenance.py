@@ -242,7 +242,7 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
     assert record["integrator"]["distribution"] == "plateimpact"
     core = record["core"]["source_modules"]
     assert {
-        "plateimpact.simulation",
+        "plateimpact.run.simulation",
         "plateimpact.model.impact",
         "plateimpact.solve.driver",
     } <= set(core)

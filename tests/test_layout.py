@@ -21,7 +21,7 @@ CORE = ROOT / "framework" / "plateimpact"
 LAYERS = {
     "physics": {"base", "units", "model"},
     "running": {
-        "solve", "registry", "simulation", "variant", "progress",
+        "solve", "registry", "run",
     },
     "storage": {"storage"},
     "analysis": {

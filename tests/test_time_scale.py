@@ -13,11 +13,11 @@ import sys
 from conftest import SCALE, TIME_SCALE
 
 import plateimpact as pi
-from plateimpact import progress
+from plateimpact.run import progress
 from plateimpact.storage import archive, provenance
 
 SHOW = (
-    "import json, plateimpact as pi; from plateimpact import progress;"
+    "import json, plateimpact as pi; from plateimpact.run import progress;"
     "from plateimpact.storage import archive, provenance;"
     "print(json.dumps([pi.Archive('a.h5').wait, progress.DELAY, provenance.GIT_TIMEOUT,"
     " pi.MAX_SECONDS.default, pi.Integrator.max_seconds]))"

@@ -63,9 +63,9 @@ _EXPORTS: dict[str, str] = {
     "contact_lost_margin": "model.geometry",
     "force_inclination": "model.geometry",
     # running
-    "Simulation": "simulation",
-    "run": "simulation",
-    "Variant": "variant",
+    "Simulation": "run.simulation",
+    "run": "run.simulation",
+    "Variant": "run.variant",
     "Outcome": "model.results",
     "Result": "model.results",
     "BatchResult": "model.results",
@@ -224,7 +224,8 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .registry.discovery import BrokenPackage
     from .registry.hookspecs import hookimpl
     from .registry.plugin_registry import PluginRegistry, default_registry, load_registry
-    from .simulation import Simulation, run
+    from .run.simulation import Simulation, run
+    from .run.variant import Variant
     from .solve.dense import DenseOutput, PolynomialDenseOutput, hermite
     from .solve.dynamics import Dynamics
     from .solve.integrator import (
@@ -242,6 +243,5 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
     from .v50 import MilStd662F, V50Fit, fit_v50, mil_std_662f
-    from .variant import Variant
 
     __version__: str

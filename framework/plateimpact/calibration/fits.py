@@ -12,7 +12,7 @@ from scipy.optimize import least_squares
 from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
 from ..model.bodies import Plate, Sphere
 from ..model.presets import DEFAULT_SPHERE
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
 from .pstar_plan import MAX_FIT_SCENES

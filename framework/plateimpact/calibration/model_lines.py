@@ -23,7 +23,7 @@ from ..model.batch import SceneBatch
 from ..model.bodies import Plate, Sphere
 from ..model.results import Outcome
 from ..model.scene import IMPACT_SPEED
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from .outcome_model import Bands, ShotLines
 
 #: The finder's tolerance [m/s]: from RELATIVE_FLOOR of the fastest speed a line can

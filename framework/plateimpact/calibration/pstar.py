@@ -17,7 +17,7 @@ from ..base.errors import CalibrationError, ConvergenceError
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
 from ..model.presets import DEFAULT_SPHERE
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .model_lines import Cost, LineModel, check_finder
 from .outcome_model import ProbabilityModel, ShotLines, allowed_outcomes, shot_lines

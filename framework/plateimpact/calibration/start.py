@@ -16,7 +16,7 @@ from ..model.batch import SceneBatch
 from ..model.bodies import Plate, Sphere
 from ..model.geometry import contact_geometry
 from ..model.results import Outcome
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
 

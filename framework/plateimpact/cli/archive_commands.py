@@ -11,7 +11,6 @@ from typing import Any
 
 from ..base.errors import ArchiveError, PluginError
 from ..base.untrusted import printable
-from ..progress import progress_bar
 from ..registry.discovery import (
     BrokenPackage,
     distribution_label,
@@ -19,6 +18,7 @@ from ..registry.discovery import (
     first_line,
     installed_entry_points,
 )
+from ..run.progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths

@@ -14,8 +14,8 @@ import numpy as np
 from .. import limits as lim
 from ..base.errors import ArchiveError
 from ..model.results import Outcome
-from ..progress import reporting_scenes
 from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
 from ..storage.archive import Archive
 from ..storage.together import write_together
 from .common import (

@@ -23,7 +23,7 @@ from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
 from ..model.impact import REST_SPEED_FRACTION, ImpactModel
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
-from ..simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from ..run.simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 from ..storage.plate_file import load_plate_file
 from .common import UsageError
 

@@ -13,9 +13,9 @@ from ..model.bodies import Plate, Sphere
 from ..model.crater import crater_section
 from ..model.results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
-from ..progress import reporting_scenes
 from ..registry.plugin_registry import PluginRegistry, default_registry
-from ..simulation import Simulation
+from ..run.progress import reporting_scenes
+from ..run.simulation import Simulation
 from ..storage.inputs import load_run_inputs
 from ..storage.provenance import inputs_record
 from ..storage.together import write_together

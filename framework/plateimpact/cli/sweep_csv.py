@@ -17,7 +17,7 @@ from ..model.batch import SceneBatch
 from ..model.bodies import Plate, Sphere
 from ..model.results import RESULT_FIELDS, BatchResult, Outcome
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 
 #: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
 SWEEP_COLUMNS = (

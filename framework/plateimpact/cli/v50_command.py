@@ -14,8 +14,8 @@ import numpy as np
 from .. import limits as lim
 from ..base.errors import V50Error
 from ..model.bodies import Sphere
-from ..progress import reporting_scenes
 from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
 from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP

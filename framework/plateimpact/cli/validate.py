@@ -11,8 +11,8 @@ import numpy as np
 
 from ..experiment import MEASURED, PREDICTED, ValidationReport, validate
 from ..experiment.validation import MAX_VALIDATE_SCENES
-from ..progress import reporting_scenes
 from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
 from ..storage.shots import Shots
 from .common import add_dpi_option, check_directory, save_figure_atomically, say
 from .describe import shown

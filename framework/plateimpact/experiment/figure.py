@@ -21,7 +21,7 @@ from ..plotting import (
     plot_outcome_strip,
     regime_key,
 )
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .validation import MEASURED, ValidationReport, measured_classes
 

@@ -36,7 +36,7 @@ from ..limits.find import check_steps
 from ..model.bodies import MASS, RADIUS, Plate, Sphere
 from ..model.results import Outcome
 from ..model.scene import IMPACT_SPEED
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
 from ..storage.shots import Shots
 

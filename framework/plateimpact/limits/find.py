@@ -22,7 +22,7 @@ from ..model.batch import SceneBatch
 from ..model.bodies import MASS, RADIUS, Plate, Sphere
 from ..model.results import BatchResult
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from ..storage.code_provenance import limits_record, plugins_record
 from ..storage.plate_file import plate_to_dict
 from ..storage.provenance import source_commit, versions

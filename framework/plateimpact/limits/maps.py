@@ -21,7 +21,7 @@ from ..base.parameters import check_instance
 from ..model.bodies import Plate, Sphere
 from ..model.results import BatchResult
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, check_steps
 from .finder import RELATIVE_FLOOR, finest_tolerance, scan_points
 from .lines import SPEED

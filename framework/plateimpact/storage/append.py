@@ -28,7 +28,7 @@ from ..base.untrusted import printable
 from ..model.batch import CORE_COLUMNS, SceneBatch
 from ..model.results import BatchResult
 from ..registry.plugin_registry import default_registry
-from ..variant import Variant
+from ..run.variant import Variant
 from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed
 from .data_files import (  # noqa: F401 (data_directory and encoded: their public home)

@@ -28,7 +28,7 @@ from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.batch import SceneBatch
 from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
-from ..variant import Variant
+from ..run.variant import Variant
 from . import append as append_module
 from . import records
 from . import stored_attributes as typed

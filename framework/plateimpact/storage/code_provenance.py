@@ -18,12 +18,12 @@ from typing import Any
 from ..base.untrusted import printable
 from ..model.plugin import Plugin
 from ..registry.plugin_registry import KINDS, plugin_origin
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from .source_hash import module_sources, source_sha256
 
 #: The core's distribution, and the module whose imports, transitively, are the core
 #: code every run executes (the model, its events, the driver, the results).
-CORE, CORE_ROOT = "plateimpact", "plateimpact.simulation"
+CORE, CORE_ROOT = "plateimpact", "plateimpact.run.simulation"
 #: The limits finder: what places a boundary and builds a map from the scenes it runs
 #: (a limits record's ``limits`` entry).
 LIMITS_ROOTS, LIMITS_PACKAGE = (

@@ -36,7 +36,7 @@ from ..model.impact import REST_SPEED_FRACTION
 from ..model.plugin import Plugin
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from .plate_file import plate_from_dict
 
 FORMAT = "plateimpact-inputs-1"

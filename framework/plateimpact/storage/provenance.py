@@ -21,8 +21,8 @@ from urllib.request import url2pathname
 from ..base.errors import PlateImpactWarning
 from ..base.parameters import Parameter
 from ..model.bodies import Plate, Sphere
-from ..simulation import Simulation
-from ..variant import Variant
+from ..run.simulation import Simulation
+from ..run.variant import Variant
 from . import inputs
 from .code_provenance import plugins_record
 from .plate_file import plate_to_dict

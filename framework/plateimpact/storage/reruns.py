@@ -18,7 +18,7 @@ import attrs
 from ..base.errors import ArchiveError, ParameterError
 from ..base.untrusted import load_json, printable
 from ..registry.plugin_registry import PluginRegistry
-from ..variant import Variant
+from ..run.variant import Variant
 from .append import RunExistsError, StudyDefinition, check_same_scenes
 from .code_provenance import changes, plugins_record
 

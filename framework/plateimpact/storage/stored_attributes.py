@@ -16,7 +16,7 @@ from typing import Any
 
 from ..base.errors import ArchiveError, PlateImpactError
 from ..base.untrusted import load_json, printable
-from ..variant import Variant
+from ..run.variant import Variant
 
 #: Run attributes holding a JSON object, and those holding text.
 JSON_OBJECTS = ("variant", "model", "versions", "failure_state_units")

@@ -13,7 +13,7 @@ from ..model.batch import SceneBatch
 from ..model.bodies import Plate, Sphere
 from ..model.results import Outcome
 from ..model.scene import IMPACT_SPEED
-from ..simulation import Simulation
+from ..run.simulation import Simulation
 from .shots import Shots
 
 

@@ -9,10 +9,10 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .base.errors import ParameterError
-from .base.untrusted import load_json
-from .model.impact import REST_SPEED_FRACTION
-from .registry.plugin_registry import PluginRegistry
+from ..base.errors import ParameterError
+from ..base.untrusted import load_json
+from ..model.impact import REST_SPEED_FRACTION
+from ..registry.plugin_registry import PluginRegistry
 from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 
 

@@ -9,16 +9,16 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .base.errors import ParameterError, PluginError
-from .model.batch import SceneBatch, check_chunk_size
-from .model.crater import crater_sections
-from .model.impact import REST_SPEED_FRACTION, ImpactModel
-from .model.results import BatchResult, Result
-from .model.scene import Scene
+from ..base.errors import ParameterError, PluginError
+from ..model.batch import SceneBatch, check_chunk_size
+from ..model.crater import crater_sections
+from ..model.impact import REST_SPEED_FRACTION, ImpactModel
+from ..model.results import BatchResult, Result
+from ..model.scene import Scene
+from ..registry.plugin_registry import PluginRegistry, default_registry
+from ..solve.driver import integrate
+from ..solve.integrator import Integrator
 from .progress import report_scenes
-from .registry.plugin_registry import PluginRegistry, default_registry
-from .solve.driver import integrate
-from .solve.integrator import Integrator
 
 #: The plug-ins a model uses unless told otherwise (the report's model).
 DEFAULT_RESISTANCE = "poncelet"
@@ -100,7 +100,7 @@ class Simulation:
         each run as one batch in a worker, and the results come back in order. A scene's
         result does not depend on the rest of its batch, so chunking changes nothing but
         the wall time. Threads gain nothing (the step loop holds the GIL between numpy
-        calls): use processes. Inside :func:`~plateimpact.progress.reporting_scenes`
+        calls): use processes. Inside :func:`~plateimpact.run.progress.reporting_scenes`
         each finished chunk advances its progress bar.
         """
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
