@@ -27,10 +27,10 @@ from plateimpact import limits, plotting, presets
 from plateimpact.base.errors import PlateImpactError
 from plateimpact.base.untrusted import load_json
 from plateimpact.experiment.figure import validation_figure
-from plateimpact.storage.code_provenance import plugins_record
+from plateimpact.provenance.code import plugins_record
+from plateimpact.provenance.metadata import versions
+from plateimpact.provenance.source_hash import module_sources, source_sha256
 from plateimpact.storage.output import write_text
-from plateimpact.storage.provenance import versions
-from plateimpact.storage.source_hash import module_sources, source_sha256
 from plateimpact.v50.figure import Panel, v50_figure
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -52,7 +52,7 @@ PROVENANCE = "experiment_provenance.json"
 
 def provenance() -> dict[str, Any]:
     """The code and data the outputs depend on: every module of plateimpact and of the
-    studies this one imports (hashed as storage.code_provenance hashes a plug-in), the
+    studies this one imports (hashed as provenance.code hashes a plug-in), the
     models' plug-ins and core, the package versions, and the shot files' SHA-256."""
     # The tools it reaches as pi.NAME (imported on first use, so not read as imports)
     # are roots beside it.

@@ -21,7 +21,7 @@ import numpy as np
 import plateimpact as pi
 from plateimpact import limits, plotting, presets
 from plateimpact.cli.common import dots_per_inch
-from plateimpact.storage.code_provenance import limits_record, plugins_record
+from plateimpact.provenance.code import limits_record, plugins_record
 from plateimpact.storage.reruns import check_code
 
 try:

@@ -27,7 +27,7 @@ import plateimpact as pi
 import plateimpact.study as study_module
 from plateimpact import limits, presets
 from plateimpact.cli import main
-from plateimpact.storage import code_provenance
+from plateimpact.provenance import code as code_provenance
 from plateimpact.storage.reruns import StaleRunError
 from plateimpact.storage.upgrade import upgrade
 

@@ -23,7 +23,7 @@ LAYERS = {
     "running": {
         "solve", "registry", "run",
     },
-    "storage": {"storage"},
+    "storage": {"storage", "provenance"},
     "analysis": {
         "study", "comparison", "calibration", "plotting", "path_figures", "limits", "export",
         "experiment", "v50",

@@ -23,7 +23,7 @@ import plateimpact as pi
 from plateimpact.cli import main
 from plateimpact.model.bodies import MASS
 from plateimpact.model.scene import IMPACT_OBLIQUITY
-from plateimpact.storage import provenance
+from plateimpact.provenance import metadata as provenance
 from plateimpact.storage.plate_file import plate_from_dict, plate_to_dict
 
 # -- the source commit ---------------------------------------------------------------

@@ -19,13 +19,13 @@ from .model.batch import SceneBatch, check_chunk_size
 from .model.bodies import Plate, Sphere
 from .model.results import BatchResult
 from .model.scene import Scene
+from .provenance.metadata import RunMetadata
 from .registry.plugin_registry import PluginRegistry
 from .run.progress import progress_bar
 from .run.simulation import DEFAULT_CHUNK_SIZE, run_chunk
 from .run.variant import Variant, check_name
 from .storage.archive import Archive
 from .storage.lock import ArchiveBusyError
-from .storage.provenance import RunMetadata
 from .storage.reruns import plan_runs
 
 if TYPE_CHECKING:

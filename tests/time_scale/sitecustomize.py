@@ -50,7 +50,7 @@ def _integrator(module: ModuleType, scale: float) -> None:
 LIMITS: dict[str, Callable[[ModuleType, float], None]] = {
     "plateimpact.storage.archive": _archive,
     "plateimpact.run.progress": _progress,
-    "plateimpact.storage.provenance": _provenance,
+    "plateimpact.provenance.metadata": _provenance,
     "plateimpact.solve.integrator": _integrator,
 }
 

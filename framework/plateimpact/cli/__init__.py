@@ -16,8 +16,8 @@ from collections.abc import Sequence
 
 from ..base.errors import ParameterError, PlateImpactError, PluginError
 from ..base.untrusted import printable
+from ..provenance.metadata import versions
 from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
-from ..storage.provenance import versions
 from . import (
     archive_commands,
     calibrate,

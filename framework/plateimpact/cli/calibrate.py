@@ -15,11 +15,11 @@ from ..base.units import g, mm
 from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
 from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..model.bodies import Plate, Sphere
+from ..provenance.metadata import versions
 from ..registry.plugin_registry import PluginRegistry
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
-from ..storage.provenance import versions
 from ..storage.shots import Shots
 from ..storage.together import write_together
 from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options

@@ -27,10 +27,10 @@ from ..calibration.pstar_plan import MAX_FIT_SCENES
 from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, Estimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
+from ..provenance.metadata import versions
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
-from ..storage.provenance import versions
 from ..storage.shots import Shots
 from .common import UsageError, check_directory, say, write_atomically
 from .options import bodies, model_choice, typed

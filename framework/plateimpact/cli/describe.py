@@ -102,7 +102,7 @@ def run_description(archive: Archive, name: str) -> list[str]:
     meta: dict[str, Any] = archive.metadata(name)
     result: BatchResult = archive.results(name)
     counts = np.bincount(result.outcome, minlength=4)[1:]
-    from ..storage.code_provenance import summary  # noqa: PLC0415 (hashing only here)
+    from ..provenance.code import summary  # noqa: PLC0415 (hashing only here)
 
     lines = [shown(name, None), *run_lines(meta)]
     # each plug-in's origin and source hash (printable already)

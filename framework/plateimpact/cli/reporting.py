@@ -20,8 +20,8 @@ from typing import Protocol, TextIO
 
 from ..base.errors import PlateImpactWarning
 from ..base.untrusted import printable
+from ..provenance.metadata import versions
 from ..registry.discovery import first_line
-from ..storage.provenance import versions
 
 
 class ShowWarning(Protocol):

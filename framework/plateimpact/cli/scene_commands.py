@@ -13,11 +13,11 @@ from ..model.bodies import Plate, Sphere
 from ..model.crater import crater_section
 from ..model.results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
+from ..provenance.inputs import load_run_inputs
+from ..provenance.metadata import inputs_record
 from ..registry.plugin_registry import PluginRegistry, default_registry
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
-from ..storage.inputs import load_run_inputs
-from ..storage.provenance import inputs_record
 from ..storage.together import write_together
 from .common import (
     UsageError,
@@ -247,7 +247,7 @@ def _parse_obliquities(text: str) -> np.ndarray:
 def sweep_inputs(
     args: argparse.Namespace, simulation: Simulation, sphere: Sphere, plate: Plate, label: str
 ) -> dict[str, Any]:
-    """The inputs record of a sweep (storage.provenance), for the sidecar of its --csv."""
+    """The inputs record of a sweep (provenance.metadata), for the sidecar of its --csv."""
     return inputs_record(
         simulation,
         sphere,

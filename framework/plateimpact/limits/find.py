@@ -22,10 +22,10 @@ from ..model.batch import SceneBatch
 from ..model.bodies import MASS, RADIUS, Plate, Sphere
 from ..model.results import BatchResult
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..provenance.code import limits_record, plugins_record
+from ..provenance.metadata import source_commit, versions
 from ..run.simulation import Simulation
-from ..storage.code_provenance import limits_record, plugins_record
 from ..storage.plate_file import plate_to_dict
-from ..storage.provenance import source_commit, versions
 from .chunked import run_chunked
 from .finder import GROUP_SCENES, RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
@@ -51,7 +51,7 @@ class Limits:
     plug-ins and settings; ``scenes`` how many scenes the finder ran, ``passes`` its
     refinement passes, ``seconds`` the wall time (for plates found together, the
     request's: see :func:`~plateimpact.limits.outcome_maps`); ``plugins`` the code
-    that found them (storage.code_provenance; None if read from a record made before
+    that found them (provenance.code; None if read from a record made before
     it was recorded).
     """
 

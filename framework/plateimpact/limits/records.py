@@ -21,11 +21,11 @@ from ..base.errors import ArchiveError, ParameterError, PlateImpactError
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from ..provenance.metadata import git_commit, versions
 from ..registry.plugin_registry import default_registry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
-from ..storage.provenance import git_commit, versions
 from ..storage.records import Column, Record
 from .find import Limits
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine

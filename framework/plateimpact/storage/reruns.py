@@ -17,10 +17,10 @@ import attrs
 
 from ..base.errors import ArchiveError, ParameterError
 from ..base.untrusted import load_json, printable
+from ..provenance.code import changes, plugins_record
 from ..registry.plugin_registry import PluginRegistry
 from ..run.variant import Variant
 from .append import RunExistsError, StudyDefinition, check_same_scenes
-from .code_provenance import changes, plugins_record
 
 #: How a caller of the Python API proceeds past a stale run.
 API_ADVICE = "overwrite=True replaces it, run_names stores the new run under another name"

@@ -23,9 +23,9 @@ from ..base.parameters import Parameter
 from ..model.bodies import Plate, Sphere
 from ..run.simulation import Simulation
 from ..run.variant import Variant
+from ..storage.plate_file import plate_to_dict
 from . import inputs
-from .code_provenance import plugins_record
-from .plate_file import plate_to_dict
+from .code import plugins_record
 
 PACKAGES = ("plateimpact", "numpy", "scipy", "attrs", "pluggy", "h5py")
 
@@ -161,8 +161,8 @@ def inputs_record(
     scene: Mapping[Parameter, float] | None = None,
     **extra: object,
 ) -> dict[str, Any]:
-    """Every input of a run, in user units, and where the code came from (storage.inputs:
-    the format; ``run --inputs`` reads it back; ``plugins``: storage.code_provenance).
+    """Every input of a run, in user units, and where the code came from (provenance.inputs:
+    the format; ``run --inputs`` reads it back; ``plugins``: provenance.code).
     ``scene`` gives values [SI] by declaration (impact speed and obliquity of one
     scene); ``extra`` adds keys as they are (a sweep's grid as typed). Without a sphere
     and plate (a study's runs, whose scenes are stored beside them): the model and

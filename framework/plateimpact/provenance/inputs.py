@@ -8,7 +8,7 @@
                "resistance_settings": {}, "failure": ..., "integrator": "dopri5",
                "integrator_settings": {"rtol": 1e-08, ...}, "rest_speed_fraction": 0.01},
      "versions": {"python": ..., "plateimpact": ..., ...}, "source_commit": "...",
-     "plugins": {"core": {...}, "resistance": {...}, ...}}  (storage.code_provenance)
+     "plugins": {"core": {...}, "resistance": {...}, ...}}  (provenance.code)
 
 Every number is in the unit its key names (``_mm``, ``_g``, ``_deg``; a setting's key is
 its declaration's :attr:`~plateimpact.Parameter.key`), written as the shortest number
@@ -16,7 +16,7 @@ that converts back to the same double (:meth:`~plateimpact.Parameter.user_number
 that :func:`read_run_inputs` rebuilds the run bit for bit. A value that no number in the
 user's unit reaches (a mass computed from a density, now and then) is written in SI
 under its SI key (``mass_kg``). ``versions``, ``source_commit`` and ``plugins`` are
-provenance (storage.provenance, storage.code_provenance), not read back. The plate is
+provenance (provenance.metadata, provenance.code), not read back. The plate is
 a plate file's object.
 """
 
@@ -37,7 +37,7 @@ from ..model.plugin import Plugin
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
 from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from ..run.simulation import Simulation
-from .plate_file import plate_from_dict
+from ..storage.plate_file import plate_from_dict
 
 FORMAT = "plateimpact-inputs-1"
 #: Keys of a record that are provenance or description, not read back (``csv_sha256``:

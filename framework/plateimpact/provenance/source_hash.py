@@ -32,7 +32,7 @@ def module_sources(
     ``exec``).
     An enclosing package's ``__init__`` is hashed (importing ``a.b`` runs it), its own
     imports followed only where a module imports it by name. Read afresh at each call
-    (storage.code_provenance keeps one answer per class)."""
+    (provenance.code keeps one answer per class)."""
     roots, followed = tuple(roots), tuple(followed)
     found: dict[str, Path | None] = {}
     read: set[str] = set()  # the modules whose imports were followed
