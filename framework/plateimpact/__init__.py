@@ -77,9 +77,9 @@ _EXPORTS: dict[str, str] = {
     "load_plate_file": "storage.plate_file",
     "save_plate_file": "storage.plate_file",
     "Shots": "storage.shots",
-    "synthetic_shots": "storage.synthetic_shots",
-    "synthetic_oblique_shots": "storage.synthetic_shots",
     # analysis
+    "synthetic_shots": "experiment.synthetic_shots",
+    "synthetic_oblique_shots": "experiment.synthetic_shots",
     "Study": "study",
     "StudyResults": "study",
     "Comparison": "comparison",
@@ -196,6 +196,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     )
     from .comparison import Comparison
     from .experiment import ValidationReport, validate
+    from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .model import batch, geometry, presets
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
@@ -240,7 +241,6 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file
     from .storage.shots import Shots
-    from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
     from .v50 import MilStd662F, V50Fit, fit_v50, mil_std_662f
 

@@ -14,7 +14,7 @@ from ..model.bodies import Plate, Sphere
 from ..model.results import Outcome
 from ..model.scene import IMPACT_SPEED
 from ..run.simulation import Simulation
-from .shots import Shots
+from ..storage.shots import Shots
 
 
 def synthetic_shots(
