@@ -26,8 +26,8 @@ from test_output_flags import CALIBRATE, SCENE
 import plateimpact as pi
 from plateimpact import limits, presets
 from plateimpact.cli import archive_commands
-from plateimpact.export import declared_column, netcdf_bytes
 from plateimpact.storage import upgrade as upgrading
+from plateimpact.storage.export import declared_column, netcdf_bytes
 from plateimpact.storage.lock import ArchiveBusyError, locked
 from plateimpact.storage.netcdf import write_run_file
 

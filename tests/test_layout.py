@@ -25,7 +25,7 @@ LAYERS = {
     },
     "storage": {"storage", "provenance"},
     "analysis": {
-        "study", "comparison", "calibration", "plotting", "path_figures", "limits", "export",
+        "study", "comparison", "calibration", "plotting", "path_figures", "limits",
         "experiment", "v50",
     },
     "cli": {"cli"},

@@ -24,7 +24,7 @@ DRIVER = textwrap.dedent(
     import io, json, os, sys
     from plateimpact.cli import build_parser, main
     # what the commands import when they need it, imported once before forking
-    import plateimpact.export, plateimpact.limits.figures, plateimpact.plotting
+    import plateimpact.storage.export, plateimpact.limits.figures, plateimpact.plotting
     import plateimpact.experiment.figure, plateimpact.v50.figure
     build_parser()
     cases = json.loads(sys.argv[1])

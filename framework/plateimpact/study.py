@@ -311,8 +311,8 @@ class StudyResults:
     def to_xarray(self) -> xarray.Dataset:
         """A grid study's runs as one xarray Dataset over (variant, plate,
         impact_obliquity, impact_speed), SI with CF ``units``; ParameterError if the
-        scenes are not one full grid (plateimpact.export.study_cube)."""
-        from .export import study_cube  # noqa: PLC0415 (xarray only when asked for)
+        scenes are not one full grid (plateimpact.storage.export.study_cube)."""
+        from .storage.export import study_cube  # noqa: PLC0415 (xarray only when asked for)
 
         return study_cube(self.study, self.runs)
 

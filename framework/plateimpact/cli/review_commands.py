@@ -41,7 +41,7 @@ def upgrade_command(args: argparse.Namespace) -> None:
 
 
 def export_command(args: argparse.Namespace) -> None:
-    from .. import export  # noqa: PLC0415 (netCDF and table writing only here)
+    from ..storage import export  # noqa: PLC0415 (netCDF and table writing only here)
 
     try:
         kind = export.export_path_kind(args.to)

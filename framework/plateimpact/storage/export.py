@@ -14,15 +14,15 @@ from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 
-from .base.errors import ParameterError
-from .base.parameters import Parameter
-from .model.batch import CORE_COLUMNS
-from .model.results import RESULT_FIELDS, BatchResult, Outcome
-from .registry.plugin_registry import default_registry
-from .storage.append import StudyDefinition
-from .storage.archive import Archive
-from .storage.data_files import encoded
-from .storage.netcdf import FLAGS, long_name, write_run_file
+from ..base.errors import ParameterError
+from ..base.parameters import Parameter
+from ..model.batch import CORE_COLUMNS
+from ..model.results import RESULT_FIELDS, BatchResult, Outcome
+from ..registry.plugin_registry import default_registry
+from .append import StudyDefinition
+from .archive import Archive
+from .data_files import encoded
+from .netcdf import FLAGS, long_name, write_run_file
 
 if TYPE_CHECKING:
     import xarray
