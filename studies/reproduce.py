@@ -22,7 +22,7 @@ import plateimpact as pi
 from plateimpact import limits, plotting, presets
 from plateimpact.cli.common import dots_per_inch
 from plateimpact.provenance.code import limits_record, plugins_record
-from plateimpact.storage.reruns import check_code
+from plateimpact.study.reruns import check_code
 
 try:
     from . import (

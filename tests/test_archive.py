@@ -128,14 +128,14 @@ KILL_SCRIPT = """
 import os, signal, sys
 import numpy as np
 import plateimpact as pi
-import plateimpact.study
-run_chunk, calls = plateimpact.study.run_chunk, [0]
+import plateimpact.study.study
+run_chunk, calls = plateimpact.study.study.run_chunk, [0]
 def chunk(*args, **kwargs):
     calls[0] += 1
     if calls[0] == 5:  # the second run's second chunk of three: killed there, not timed
         os.kill(os.getpid(), signal.SIGKILL)
     return run_chunk(*args, **kwargs)
-plateimpact.study.run_chunk = chunk
+plateimpact.study.study.run_chunk = chunk
 study = pi.Study.grid(
     "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20),
     [pi.Variant("fast"),

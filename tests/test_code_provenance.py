@@ -24,12 +24,12 @@ import pytest
 from conftest import THIRD_PARTY
 
 import plateimpact as pi
-import plateimpact.study as study_module
+import plateimpact.study.study as study_module
 from plateimpact import limits, presets
 from plateimpact.cli import main
 from plateimpact.provenance import code as code_provenance
-from plateimpact.storage.reruns import StaleRunError
 from plateimpact.storage.upgrade import upgrade
+from plateimpact.study.reruns import StaleRunError
 
 PACKAGE = "plateimpact_isotropic"
 BUILTINS = Path(__file__).resolve().parents[1] / "plugins" / "plateimpact_plugins"

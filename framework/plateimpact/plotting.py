@@ -30,7 +30,7 @@ from .storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, write_output
 if TYPE_CHECKING:
     from .calibration import DriFit
     from .storage.shots import Shots
-    from .study import StudyResults
+    from .study.study import StudyResults
 
 
 def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:

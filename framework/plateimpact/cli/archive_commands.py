@@ -22,7 +22,7 @@ from ..run.progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths
-from ..study import Study, StudyResults
+from ..study.study import Study, StudyResults
 from .common import UsageError, add_dpi_option, check_directory, output_directory, say
 from .describe import run_description
 from .run_comparison import print_comparison
@@ -164,7 +164,7 @@ REPRODUCE_SPARE = 128
 
 
 def reproduce_command(args: argparse.Namespace) -> None:
-    from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
+    from ..study.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
 
     reproduce = study_collection("report")
     if args.out is None:  # a quick archive holds other scenes: never the full one's place

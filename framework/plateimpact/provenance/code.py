@@ -1,7 +1,7 @@
 """Which code computed a result: each plug-in's distribution, version and source hash, and
 the core's (docs/archive.md, "Provenance"). Runs, sweeps, limits and maps record it as
 ``plugins``; a resumed study keeps a stored run only if its record matches the code it
-would run now (storage.reruns).
+would run now (study.reruns).
 
 Hashes are computed once per plug-in class and once for the core, per process, on the
 first record asked for, never per run or scene.

@@ -12,21 +12,21 @@ from typing import TYPE_CHECKING
 import attrs
 import numpy as np
 
-from .base.errors import ArchiveWaitWarning, ParameterError, UnknownNameError
-from .comparison.ranges import Comparison
-from .model import presets
-from .model.batch import SceneBatch, check_chunk_size
-from .model.bodies import Plate, Sphere
-from .model.results import BatchResult
-from .model.scene import Scene
-from .provenance.metadata import RunMetadata
-from .registry.plugin_registry import PluginRegistry
-from .run.progress import progress_bar
-from .run.simulation import DEFAULT_CHUNK_SIZE, run_chunk
-from .run.variant import Variant, check_name
-from .storage.archive import Archive
-from .storage.lock import ArchiveBusyError
-from .storage.reruns import plan_runs
+from ..base.errors import ArchiveWaitWarning, ParameterError, UnknownNameError
+from ..comparison.ranges import Comparison
+from ..model import presets
+from ..model.batch import SceneBatch, check_chunk_size
+from ..model.bodies import Plate, Sphere
+from ..model.results import BatchResult
+from ..model.scene import Scene
+from ..provenance.metadata import RunMetadata
+from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import progress_bar
+from ..run.simulation import DEFAULT_CHUNK_SIZE, run_chunk
+from ..run.variant import Variant, check_name
+from ..storage.archive import Archive
+from ..storage.lock import ArchiveBusyError
+from .reruns import plan_runs
 
 if TYPE_CHECKING:
     import xarray
@@ -312,7 +312,7 @@ class StudyResults:
         """A grid study's runs as one xarray Dataset over (variant, plate,
         impact_obliquity, impact_speed), SI with CF ``units``; ParameterError if the
         scenes are not one full grid (plateimpact.storage.export.study_cube)."""
-        from .storage.export import study_cube  # noqa: PLC0415 (xarray only when asked for)
+        from ..storage.export import study_cube  # noqa: PLC0415 (xarray only when asked for)
 
         return study_cube(self.study, self.runs)
 

@@ -20,7 +20,7 @@ from ..base.untrusted import load_json, printable
 from ..provenance.code import changes, plugins_record
 from ..registry.plugin_registry import PluginRegistry
 from ..run.variant import Variant
-from .append import RunExistsError, StudyDefinition, check_same_scenes
+from ..storage.append import RunExistsError, StudyDefinition, check_same_scenes
 
 #: How a caller of the Python API proceeds past a stale run.
 API_ADVICE = "overwrite=True replaces it, run_names stores the new run under another name"
@@ -38,7 +38,7 @@ class StaleRunError(RunExistsError):
 
 
 if TYPE_CHECKING:
-    from .archive import Archive
+    from ..storage.archive import Archive
 
 
 @attrs.frozen
