@@ -271,9 +271,9 @@ def test_stored_limits_keep_their_record_and_older_ones_read_without_it(tmp_path
     assert found.plugins["limits"]["source_modules"][-1] == "plateimpact.limits.regimes"
     limits.archive_limits(tmp_path / "a.h5", "l", found)
     assert limits.read_limits(tmp_path / "a.h5", "l").plugins == found.plugins
-    record = limits.records.to_record(found)
+    record = limits.archived.to_record(found)
     del record.attributes["plugins"]  # as written before plug-in provenance was
-    assert limits.records.from_record(record).plugins is None
+    assert limits.archived.from_record(record).plugins is None
 
 
 def test_hashes_are_computed_once_per_class_and_process(monkeypatch):

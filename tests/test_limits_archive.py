@@ -20,7 +20,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.limits.records import attributes_of
+from plateimpact.limits.archived import attributes_of
 from plateimpact.storage import append as appending
 from plateimpact.storage.lock import locked
 

@@ -27,7 +27,7 @@ import numpy as np
 from scipy.optimize import elementwise, minimize
 
 from ..base.errors import ConvergenceError
-from ..limits.finder import GROUP_SCENES, scan_intervals
+from ..limits.bracketing import GROUP_SCENES, scan_intervals
 from .model_lines import Cost, LineModel
 from .outcome_model import Bands, ProbabilityModel, ShotLines, log_likelihood
 

@@ -32,7 +32,7 @@ from ..limits import (
     along_speed,
 )
 from ..limits.chunked import run_chunked
-from ..limits.find import check_steps
+from ..limits.plate_limits import check_steps
 from ..model.bodies import MASS, RADIUS, Plate, Sphere
 from ..model.results import Outcome
 from ..model.scene import IMPACT_SPEED

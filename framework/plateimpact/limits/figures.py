@@ -22,9 +22,9 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from ..plotting import figure, regime_colour, regime_key
-from .find import Limits
 from .lines import OBLIQUITY
 from .maps import OutcomeMap
+from .plate_limits import Limits
 from .regimes import REGIMES, Regime
 
 _DEG = math.pi / 180.0

@@ -27,7 +27,7 @@ CORE, CORE_ROOT = "plateimpact", "plateimpact.run.simulation"
 #: The limits finder: what places a boundary and builds a map from the scenes it runs
 #: (a limits record's ``limits`` entry).
 LIMITS_ROOTS, LIMITS_PACKAGE = (
-    ("plateimpact.limits.find", "plateimpact.limits.maps"),
+    ("plateimpact.limits.plate_limits", "plateimpact.limits.maps"),
     "plateimpact.limits",
 )
 #: The built-in plug-ins' package, whose shared declarations (plate constants) third-party

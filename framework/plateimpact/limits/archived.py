@@ -26,10 +26,10 @@ from ..registry.plugin_registry import default_registry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
-from ..storage.records import Column, Record
-from .find import Limits
+from ..storage.records import Record, RecordColumn
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
+from .plate_limits import Limits
 from .regimes import REGIMES, Regime
 
 KIND_LIMITS, KIND_MAP = "limits", "outcome_map"
@@ -45,7 +45,7 @@ _OTHER = {SPEED: OBLIQUITY, OBLIQUITY: SPEED}
 _CODES = "regime code 2 x outcome + plate_failed (see the regimes attribute)"
 
 
-def _axis_columns(limits: Limits) -> dict[str, Column]:
+def _axis_columns(limits: Limits) -> dict[str, RecordColumn]:
     axis, lines = limits.axis, limits.lines
     unit, other = UNITS[axis], _OTHER[axis]
     along = NAMES[axis]
@@ -54,17 +54,28 @@ def _axis_columns(limits: Limits) -> dict[str, Column]:
         return math.nan if value is None else value
 
     columns = {
-        "lines/fixed": Column(
-            np.array([line.fixed for line in lines]), UNITS[other], NAMES[other],
+        "lines/fixed": RecordColumn(
+            np.array([line.fixed for line in lines]),
+            UNITS[other],
+            NAMES[other],
             f"the {NAMES[other]} at which each line runs along {along}",
         ),
-        "lines/start": Column(np.array([line.start for line in lines]), unit, f"start {along}",
-                              "where each line starts"),
-        "lines/end": Column(np.array([line.end for line in lines]), unit, f"end {along}",
-                            "where each line ends"),
-        "lines/first": Column(np.array([line.first.code for line in lines], dtype=np.int8), "1",
-                              "first regime", f"each line's regime at its start: {_CODES}"),
-    }  # fmt: skip
+        "lines/start": RecordColumn(
+            np.array([line.start for line in lines]),
+            unit,
+            f"start {along}",
+            "where each line starts",
+        ),
+        "lines/end": RecordColumn(
+            np.array([line.end for line in lines]), unit, f"end {along}", "where each line ends"
+        ),
+        "lines/first": RecordColumn(
+            np.array([line.first.code for line in lines], dtype=np.int8),
+            "1",
+            "first regime",
+            f"each line's regime at its start: {_CODES}",
+        ),
+    }
     if axis == SPEED:
         for key, what in (
             ("ballistic_limit", "lowest speed above which every scene perforates"),
@@ -72,34 +83,52 @@ def _axis_columns(limits: Limits) -> dict[str, Column]:
             ("ricochet_limit", "highest speed at which the sphere ricochets"),
         ):
             values = [named(getattr(line, key)) for line in lines]
-            columns[f"lines/{key}"] = Column(np.array(values), unit, key.replace("_", " "),
-                                             f"the {what} (NaN: none on the line)")  # fmt: skip
+            columns[f"lines/{key}"] = RecordColumn(
+                np.array(values), unit, key.replace("_", " "), f"the {what} (NaN: none on the line)"
+            )
     else:
         values = [named(line.critical_ricochet_obliquity) for line in lines]
-        columns["lines/critical_ricochet_obliquity"] = Column(
-            np.array(values), unit, "critical ricochet obliquity",
+        columns["lines/critical_ricochet_obliquity"] = RecordColumn(
+            np.array(values),
+            unit,
+            "critical ricochet obliquity",
             "the lowest obliquity above which every scene ricochets (NaN: none on the line)",
-        )  # fmt: skip
+        )
     found = [(i, b) for i, line in enumerate(lines) for b in line.boundaries]
     at = np.array([b.at for _, b in found], dtype=float)
     columns |= {
-        "boundaries/line": Column(np.array([i for i, _ in found], dtype=np.int32), "1", "line",
-                                  "index of the boundary's line in lines/"),
-        "boundaries/low": Column(np.array([b.low for _, b in found], dtype=float), unit,
-                                 f"{along} below", "a scene here ends in the regime below"),
-        "boundaries/high": Column(np.array([b.high for _, b in found], dtype=float), unit,
-                                  f"{along} above", "a scene here ends in the regime above"),
-        "boundaries/at": Column(at, unit, f"boundary {along}",
-                                "midpoint of low and high, within half the tolerance"),
-        "boundaries/below": Column(np.array([b.below.code for _, b in found], dtype=np.int8),
-                                   "1", "regime below", _CODES),
-        "boundaries/above": Column(np.array([b.above.code for _, b in found], dtype=np.int8),
-                                   "1", "regime above", _CODES),
-    }  # fmt: skip
+        "boundaries/line": RecordColumn(
+            np.array([i for i, _ in found], dtype=np.int32),
+            "1",
+            "line",
+            "index of the boundary's line in lines/",
+        ),
+        "boundaries/low": RecordColumn(
+            np.array([b.low for _, b in found], dtype=float),
+            unit,
+            f"{along} below",
+            "a scene here ends in the regime below",
+        ),
+        "boundaries/high": RecordColumn(
+            np.array([b.high for _, b in found], dtype=float),
+            unit,
+            f"{along} above",
+            "a scene here ends in the regime above",
+        ),
+        "boundaries/at": RecordColumn(
+            at, unit, f"boundary {along}", "midpoint of low and high, within half the tolerance"
+        ),
+        "boundaries/below": RecordColumn(
+            np.array([b.below.code for _, b in found], dtype=np.int8), "1", "regime below", _CODES
+        ),
+        "boundaries/above": RecordColumn(
+            np.array([b.above.code for _, b in found], dtype=np.int8), "1", "regime above", _CODES
+        ),
+    }
     return columns
 
 
-def _body_columns(sphere: Sphere, plate: Plate) -> dict[str, Column]:
+def _body_columns(sphere: Sphere, plate: Plate) -> dict[str, RecordColumn]:
     declared = default_registry().plate_constants
     columns = {}
     for where, parameter, value in [
@@ -109,7 +138,7 @@ def _body_columns(sphere: Sphere, plate: Plate) -> dict[str, Column]:
         *((f"plate/{name}", declared.get(name), value) for name, value in plate.constants),
     ]:
         parameter = parameter or Parameter(where, "plate constant (no plug-in declares it)")
-        columns[where] = Column(
+        columns[where] = RecordColumn(
             np.array([value]), parameter.unit or "1", parameter.name, parameter.description
         )
     return columns
@@ -148,16 +177,23 @@ def to_record(found: Limits | OutcomeMap) -> Record:
     columns = _body_columns(limits.sphere, limits.plate) | _axis_columns(limits)
     if isinstance(found, OutcomeMap):
         columns |= {
-            "map/speeds": Column(found.speeds, "m/s", "impact speed", "the grid's columns"),
-            "map/obliquities": Column(found.obliquities, "rad", "impact obliquity",
-                                      "the grid's rows"),
-            "map/regime": Column(found.regime, "1", "regime",
-                                 f"rows: obliquities, columns: speeds; {_CODES}"),
-            "map/exit_speed": Column(found.exit_speed, "m/s", "exit speed",
-                                     "rows: obliquities, columns: speeds (0 at rest)"),
-            "map/exit_obliquity": Column(found.exit_obliquity, "rad", "exit obliquity",
-                                         "rows: obliquities, columns: speeds"),
-        }  # fmt: skip
+            "map/speeds": RecordColumn(found.speeds, "m/s", "impact speed", "the grid's columns"),
+            "map/obliquities": RecordColumn(
+                found.obliquities, "rad", "impact obliquity", "the grid's rows"
+            ),
+            "map/regime": RecordColumn(
+                found.regime, "1", "regime", f"rows: obliquities, columns: speeds; {_CODES}"
+            ),
+            "map/exit_speed": RecordColumn(
+                found.exit_speed,
+                "m/s",
+                "exit speed",
+                "rows: obliquities, columns: speeds (0 at rest)",
+            ),
+            "map/exit_obliquity": RecordColumn(
+                found.exit_obliquity, "rad", "exit obliquity", "rows: obliquities, columns: speeds"
+            ),
+        }
     return Record(attributes, columns)
 
 

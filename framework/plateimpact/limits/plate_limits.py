@@ -2,7 +2,7 @@
 
 ``along_speed`` sweeps impact speed at fixed obliquities (ballistic and ricochet
 limits); ``along_obliquity`` sweeps obliquity at fixed speeds (the critical ricochet
-obliquity). Both run any simulation, all lines in one batch per pass (limits.finder).
+obliquity). Both run any simulation, all lines in one batch per pass (limits.bracketing).
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ from ..provenance.code import limits_record, plugins_record
 from ..provenance.metadata import source_commit, versions
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
+from .bracketing import GROUP_SCENES, RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
 from .chunked import run_chunked
-from .finder import GROUP_SCENES, RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
 from .regimes import Regime, regime_codes
 
@@ -126,7 +126,7 @@ def check_steps(
     """Tolerance in [RELATIVE_FLOOR of the range's largest value, the range's width];
     resolution in [tolerance, the width]; a scan of at most GROUP_SCENES samples a line
     and ``max_scenes`` (None: any number) in all. The floor is what a double resolves
-    there: finer cuts would coincide (limits.finder)."""
+    there: finer cuts would coincide (limits.bracketing)."""
     width = span[1] - span[0]
     shown = f"{width / scale:.6g} {unit}"
     floor = finest_tolerance(np.array([span[0]]), np.array([span[1]]))
