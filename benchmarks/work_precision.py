@@ -22,7 +22,7 @@ import numpy as np
 from scenes import benchmark_batch
 
 import plateimpact as pi
-from plateimpact import plotting
+from plateimpact.figures import exit_curves as plotting
 
 RESULTS = Path(__file__).resolve().parent / "results"
 #: The reference's tolerance. solve_ivp steps across the force's branch surfaces (it has

@@ -6,8 +6,9 @@ import argparse
 from pathlib import Path
 
 import plateimpact as pi
-from plateimpact import path_figures, plotting
 from plateimpact.cli.common import dots_per_inch
+from plateimpact.figures import exit_curves as plotting
+from plateimpact.figures import study_paths as path_figures
 
 #: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]

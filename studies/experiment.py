@@ -23,15 +23,16 @@ from pathlib import Path
 from typing import Any
 
 import plateimpact as pi
-from plateimpact import limits, plotting, presets
+from plateimpact import limits, presets
 from plateimpact.base.errors import PlateImpactError
 from plateimpact.base.untrusted import load_json
-from plateimpact.experiment.figure import validation_figure
+from plateimpact.figures import exit_curves as plotting
+from plateimpact.figures.v50_fits import Panel, v50_figure
+from plateimpact.figures.validation_panels import validation_figure
 from plateimpact.provenance.code import plugins_record
 from plateimpact.provenance.metadata import versions
 from plateimpact.provenance.source_hash import module_sources, source_sha256
 from plateimpact.storage.output import write_text
-from plateimpact.v50.figure import Panel, v50_figure
 
 DATA = Path(__file__).resolve().parent / "data"
 PLATE = "SAE1010/1.47"

@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import plateimpact as pi
-from plateimpact import limits, plotting, presets
+from plateimpact import limits, presets
+from plateimpact.figures import exit_curves as plotting
 from plateimpact.model.crater import crater_section
 from plateimpact.units import deg, mm
 from plateimpact_plugins import Hinge
@@ -148,7 +149,7 @@ def hinge_geometry(out: Path) -> Path:
 
 
 def outcome_map(out: Path) -> Path:
-    from plateimpact.limits.figures import plot_outcome_map  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_outcome_map  # noqa: PLC0415
 
     plate = presets.plate("2024-T3/3.18")
     found = limits.outcome_map(pi.Simulation.from_names(), SPHERE, plate)
@@ -158,7 +159,7 @@ def outcome_map(out: Path) -> Path:
 
 
 def limit_curves(out: Path) -> Path:
-    from plateimpact.limits.figures import plot_limit_curves  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_limit_curves  # noqa: PLC0415
 
     simulation = pi.Simulation.from_names()
     maps = [

@@ -19,8 +19,9 @@ from pathlib import Path
 import numpy as np
 
 import plateimpact as pi
-from plateimpact import limits, plotting, presets
+from plateimpact import limits, presets
 from plateimpact.cli.common import dots_per_inch
+from plateimpact.figures import exit_curves as plotting
 from plateimpact.provenance.code import limits_record, plugins_record
 from plateimpact.study.reruns import check_code
 
@@ -109,7 +110,7 @@ def outcome_maps(
     if there; with ``overwrite``, replaced), and drawn: ``outcome_maps.<suffix>`` and
     ``limit_curves.<suffix>`` (at ``dpi`` [dots per inch] if a raster); ``quick``: on
     the small grid of --quick."""
-    from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     names = map_names(tag)
     stored = kept_maps(archive, names) if resume else set()

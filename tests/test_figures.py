@@ -14,8 +14,8 @@ import pytest
 from matplotlib.colors import to_rgba
 
 import plateimpact as pi
-from plateimpact import plotting
 from plateimpact.cli import main as cli
+from plateimpact.figures import exit_curves as plotting
 from plateimpact.limits import Regime, regime_codes
 
 SPEEDS = np.arange(50.0, 1501.0, 50.0)  # 30 speeds: every outcome of the 3.18-mm plate
@@ -94,7 +94,7 @@ def key_colours(legend):
 
 
 def test_the_family_key_and_the_outcome_maps_share_one_palette(eight_obliquities):
-    from plateimpact.limits.figures import plot_bands  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_bands  # noqa: PLC0415
 
     family = key_colours(plotting.plot_study(eight_obliquities).legends[0])
     found = pi.limits.along_speed(

@@ -25,7 +25,7 @@ LAYERS = {
     },
     "storage": {"storage", "provenance"},
     "analysis": {
-        "study", "comparison", "calibration", "plotting", "path_figures", "limits",
+        "study", "comparison", "calibration", "figures", "limits",
         "experiment", "v50",
     },
     "cli": {"cli"},
@@ -158,7 +158,8 @@ def test_importing_the_package_loads_none_of_its_heavy_dependencies():
 
 def test_plotting_leaves_the_users_matplotlib_backend_alone():
     code = (
-        "import matplotlib; before = matplotlib.get_backend(); import plateimpact.plotting; "
+        "import matplotlib; before = matplotlib.get_backend(); "
+        "import plateimpact.figures.exit_curves; "
         "import matplotlib.pyplot as plt; print(before, plt.get_backend())"
     )
     assert run_python(code, MPLBACKEND="svg") == "svg svg"

@@ -268,8 +268,8 @@ def compare_command(args: argparse.Namespace) -> None:
     comparison = results.compare(archive.resolve(args.run_a), archive.resolve(args.run_b))
     print_comparison(comparison, as_json=args.json, summary=args.summary)
     if args.png:
-        from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
-        from ..comparison.figure import plot_comparison  # noqa: PLC0415
+        from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.compared_runs import plot_comparison  # noqa: PLC0415
 
         plotting.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
         if not args.json:
@@ -277,8 +277,8 @@ def compare_command(args: argparse.Namespace) -> None:
 
 
 def plot_command(args: argparse.Namespace) -> None:
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
-    from ..path_figures import plot_study_paths  # noqa: PLC0415
+    from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.study_paths import plot_study_paths  # noqa: PLC0415
 
     check_directory(args.out, "--out", "figure")
     for speed in args.speed or ():

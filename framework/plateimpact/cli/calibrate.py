@@ -235,7 +235,7 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
 
 def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
     """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
     normal = report.shots.normal_incidence()
     speeds = np.linspace(

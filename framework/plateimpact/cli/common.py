@@ -120,7 +120,7 @@ def save_figure_atomically(
 ) -> None:
     """Save a figure to ``path`` (format from its extension), all of it or nothing;
     ``dpi`` [dots per inch] for a raster (default: plotting's)."""
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
     plotting.save(fig, path, flag, dpi=plotting.DPI if dpi is None else dpi)
 
@@ -133,7 +133,7 @@ def text_output(path: str, text: str, flag: str, kind: str = "csv") -> Output:
 def figure_output(fig: Figure, path: str, flag: str, dpi: float | None = None) -> Output:
     """A figure to ``path`` (format from its extension; ``dpi`` [dots per inch] for a
     raster, default plotting's): one file of a set written together."""
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
     writer = plotting.figure_writer(fig, path, plotting.DPI if dpi is None else dpi)
     return Output(path, flag, writer, "figure")

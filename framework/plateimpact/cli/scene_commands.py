@@ -208,7 +208,7 @@ def crater_command(args: argparse.Namespace) -> None:
         rows = zip(section.lateral / lateral.scale, section.depth / depth.scale, strict=True)
         outputs.append(text_output(args.csv, csv_text([lateral.key, depth.key], rows), "--csv"))
     if args.png is not None:
-        from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
 
         fig, ax = plotting.figure(figsize=(8, 4))
         plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)

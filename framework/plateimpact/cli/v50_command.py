@@ -234,7 +234,7 @@ def v50_command(args: argparse.Namespace) -> None:
         reasons = "; ".join(f"{math.degrees(o):g} deg: {r}" for o, r in results.items())
         raise V50Error(f"{args.shots}: no obliquity gives a V50; {reasons}")
     if args.png is not None:
-        from ..v50.figure import Panel, v50_figure  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.v50_fits import Panel, v50_figure  # noqa: PLC0415 (matplotlib only when drawing)
 
         panels = [
             Panel(f"{math.degrees(o):g} deg", groups[o].impact_speed, groups[o].perforated,

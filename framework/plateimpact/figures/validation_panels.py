@@ -11,8 +11,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..base.errors import ShotDataError
+from ..experiment.validation import MEASURED, ValidationReport, measured_classes
 from ..model.batch import SceneBatch
-from ..plotting import (
+from ..run.simulation import Simulation
+from ..storage.shots import Shots
+from .exit_curves import (
     FONT,
     MAX_COLUMNS,
     PAGE_WIDTH,
@@ -21,9 +24,6 @@ from ..plotting import (
     plot_outcome_strip,
     regime_key,
 )
-from ..run.simulation import Simulation
-from ..storage.shots import Shots
-from .validation import MEASURED, ValidationReport, measured_classes
 
 #: Model-curve points per obliquity.
 CURVE_POINTS = 300

@@ -11,11 +11,11 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from .model.results import Outcome
-from .plotting import FONT, PAGE_WIDTH, SMALL, figure, short_run_name, study_panels
+from ..model.results import Outcome
+from .exit_curves import FONT, PAGE_WIDTH, SMALL, figure, short_run_name, study_panels
 
 if TYPE_CHECKING:
-    from .study.study import StudyResults
+    from ..study.study import StudyResults
 
 #: What :func:`plot_study_paths` can draw from a run.
 PATH_KINDS = ("trajectory", "crater")

@@ -21,11 +21,11 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ..plotting import figure, regime_colour, regime_key
-from .lines import OBLIQUITY
-from .maps import OutcomeMap
-from .plate_limits import Limits
-from .regimes import REGIMES, Regime
+from ..limits.lines import OBLIQUITY
+from ..limits.maps import OutcomeMap
+from ..limits.plate_limits import Limits
+from ..limits.regimes import REGIMES, Regime
+from .exit_curves import figure, regime_colour, regime_key
 
 _DEG = math.pi / 180.0
 

@@ -23,14 +23,14 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from .limits.regimes import REGIMES, Regime, regime_codes
-from .model.results import BatchResult, CraterSection, Outcome, Trajectory
-from .storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, write_output
+from ..limits.regimes import REGIMES, Regime, regime_codes
+from ..model.results import BatchResult, CraterSection, Outcome, Trajectory
+from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, write_output
 
 if TYPE_CHECKING:
-    from .calibration import DriFit
-    from .storage.shots import Shots
-    from .study.study import StudyResults
+    from ..calibration import DriFit
+    from ..storage.shots import Shots
+    from ..study.study import StudyResults
 
 
 def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
