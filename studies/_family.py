@@ -7,7 +7,7 @@ from pathlib import Path
 
 import plateimpact as pi
 from plateimpact.cli.common import dots_per_inch
-from plateimpact.figures import exit_curves as plotting
+from plateimpact.figures import exit_curves, saving
 from plateimpact.figures import study_paths as path_figures
 
 #: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
@@ -28,7 +28,7 @@ def run_and_plot(
     resume: bool = False,
     overwrite: bool = False,
     tag: str | None = None,
-    dpi: float = plotting.DPI,
+    dpi: float = saving.DPI,
     suffix: str = "png",
 ) -> Path:
     """Run ``study`` (appending its runs to ``archive``; with ``resume``, only those not
@@ -43,16 +43,16 @@ def run_and_plot(
     if craters:
         figure = path_figures.plot_study_paths(results, kind="crater")
     else:
-        figure = plotting.plot_study(results)
+        figure = exit_curves.plot_study(results)
     path = out / f"{study.name}.{suffix}"
-    plotting.save(figure, str(path), dpi=dpi)
+    saving.save(figure, str(path), dpi=dpi)
     return path
 
 
 def main(study: pi.Study, craters: bool = False) -> None:
     parser = argparse.ArgumentParser(description=study.description)
     parser.add_argument("--out", default=".", help="directory for the archive and the figure")
-    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--dpi", type=dots_per_inch, default=saving.DPI, help="PNG resolution")
     parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     out = Path(args.out)

@@ -156,10 +156,11 @@ def test_importing_the_package_loads_none_of_its_heavy_dependencies():
     assert run_python(code) == "[]"
 
 
-def test_plotting_leaves_the_users_matplotlib_backend_alone():
+def test_figures_leave_the_users_matplotlib_backend_alone():
+    figures = sorted(p.stem for p in (CORE / "figures").glob("*.py") if p.stem != "__init__")
     code = (
-        "import matplotlib; before = matplotlib.get_backend(); "
-        "import plateimpact.figures.exit_curves; "
+        "import importlib, matplotlib; before = matplotlib.get_backend(); "
+        f"[importlib.import_module('plateimpact.figures.' + m) for m in {figures!r}]; "
         "import matplotlib.pyplot as plt; print(before, plt.get_backend())"
     )
     assert run_python(code, MPLBACKEND="svg") == "svg svg"

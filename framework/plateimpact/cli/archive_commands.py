@@ -268,16 +268,17 @@ def compare_command(args: argparse.Namespace) -> None:
     comparison = results.compare(archive.resolve(args.run_a), archive.resolve(args.run_b))
     print_comparison(comparison, as_json=args.json, summary=args.summary)
     if args.png:
-        from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures import saving  # noqa: PLC0415 (matplotlib only when drawing)
         from ..figures.compared_runs import plot_comparison  # noqa: PLC0415
 
-        plotting.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
+        saving.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
         if not args.json:
             say(f"figure: {args.png}")
 
 
 def plot_command(args: argparse.Namespace) -> None:
-    from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures import saving  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.exit_curves import plot_study  # noqa: PLC0415
     from ..figures.study_paths import plot_study_paths  # noqa: PLC0415
 
     check_directory(args.out, "--out", "figure")
@@ -288,13 +289,13 @@ def plot_command(args: argparse.Namespace) -> None:
         results = _study_results(Archive(args.archive), args.run)
         stages.update()
         if args.kind == "exit":
-            figure = plotting.plot_study(results)
+            figure = plot_study(results)
         else:
             try:
                 figure = plot_study_paths(results, kind=args.kind, speeds=args.speed)
             except ValueError as exc:
                 raise UsageError(str(exc)) from None
         stages.update()
-        plotting.save(figure, args.out, "--out", dpi=args.dpi)
+        saving.save(figure, args.out, "--out", dpi=args.dpi)
         stages.update()
     say(f"figure: {args.out}")

@@ -235,7 +235,8 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
 
 def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
     """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
-    from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.calibration_fit import plot_calibration  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.style import figure  # noqa: PLC0415
 
     normal = report.shots.normal_incidence()
     speeds = np.linspace(
@@ -245,8 +246,8 @@ def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -
     curves = model_residual_speeds(
         simulation, sphere, fits[0].plate, speeds, [(f.a, f.b) for f in fits]
     )
-    fig, ax = plotting.figure(figsize=(7, 5))
-    plotting.plot_calibration(
+    fig, ax = figure(figsize=(7, 5))
+    plot_calibration(
         ax,
         normal,
         report.dri,

@@ -208,10 +208,11 @@ def crater_command(args: argparse.Namespace) -> None:
         rows = zip(section.lateral / lateral.scale, section.depth / depth.scale, strict=True)
         outputs.append(text_output(args.csv, csv_text([lateral.key, depth.key], rows), "--csv"))
     if args.png is not None:
-        from ..figures import exit_curves as plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.crater_sections import plot_crater  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.style import figure  # noqa: PLC0415
 
-        fig, ax = plotting.figure(figsize=(8, 4))
-        plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
+        fig, ax = figure(figsize=(8, 4))
+        plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
         speed, obliquity = float(args.speed), float(args.obliquity)
         ax.set_title(f"{label}, {speed:g} m/s at {obliquity:g}°: {result.outcome.label}")
         outputs.append(figure_output(fig, args.png, "--png", args.dpi))

@@ -10,7 +10,7 @@ from matplotlib.patches import Patch
 from ..comparison.ranges import Comparison, ComparisonRow
 from ..limits.lines import SPEED
 from ..model.results import Outcome
-from .exit_curves import figure
+from .style import figure
 
 #: Shades of the ranges whose outcome differs, one per change (A's regime -> B's).
 CHANGE_SHADES = ("#f6d2cc", "#d5e5f5", "#f7e6c4", "#e4d9f0", "#d6eedb", "#e8e8e8")

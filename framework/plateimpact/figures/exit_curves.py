@@ -1,79 +1,36 @@
-"""Figures in the layout of the report: outcome curves against impact speed, craters.
-
-matplotlib is imported here (and in path_figures and limits.figures, which draw with
-these pieces) only, so the rest of plateimpact does not need a display or pay the
-import time. Figures are made as :class:`matplotlib.figure.Figure` objects,
-not through pyplot: nothing here touches the user's backend or pyplot's state, so the
-functions work the same in a script, a notebook and an interactive session. Functions
-draw on axes you pass and return them; :func:`figure` gives a figure and its axes.
+"""Exit speed and exit obliquity against impact speed, in the layout of the report's
+Figures 11-44: the curves and outcome strip of one run (:func:`plot_exit_curves`,
+:func:`plot_outcome_strip`), and a study's figure of every plate and obliquity
+(:func:`plot_study`).
 """
 
 from __future__ import annotations
 
 import math
-import os
 import textwrap
-from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
 
-from ..limits.regimes import REGIMES, Regime, regime_codes
-from ..model.results import BatchResult, CraterSection, Outcome, Trajectory
-from ..storage.output import FIGURE_DPI, FIGURE_DPI_RANGE, write_output
+from ..limits.regimes import Regime, regime_codes
+from ..model.results import BatchResult, Outcome
+from .style import (
+    COLUMN_WIDTH,
+    FONT,
+    MAX_COLUMNS,
+    PAGE_WIDTH,
+    RUN_STYLES,
+    SMALL,
+    regime_colour,
+    regime_key,
+)
 
 if TYPE_CHECKING:
-    from ..calibration import DriFit
-    from ..storage.shots import Shots
     from ..study.study import StudyResults
-
-
-def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
-    """A new figure (outside pyplot) and its axes, as ``pyplot.subplots`` returns them."""
-    fig = Figure(figsize=kwargs.pop("figsize", None), layout=kwargs.pop("layout", None))
-    return fig, fig.subplots(nrows, ncols, **kwargs)
-
-
-#: Resolution of saved raster figures by default, and the range accepted [dots per inch].
-DPI, DPI_RANGE = FIGURE_DPI, FIGURE_DPI_RANGE
-#: Journal widths [in]: one column, two columns (the page).
-COLUMN_WIDTH, PAGE_WIDTH = 3.5, 7.2
-#: Font sizes [pt] of figures drawn at journal width: labels and titles, ticks and keys.
-FONT, SMALL = 7.0, 6.0
-#: The most columns of panels a study figure has; more obliquities make more rows.
-MAX_COLUMNS = 4
-
-#: One colour per regime, shared by the family figures' outcome strips and the outcome
-#: maps (limits.figures); the thin-plate band (ricochet after failure) stands out.
-REGIME_COLOURS = {
-    REGIMES[0]: "#4c72b0",  # ricochet
-    REGIMES[1]: "#a05fc0",  # ricochet after failure
-    REGIMES[2]: "#dd8452",  # embedment
-    REGIMES[3]: "#e6c85a",  # embedment after failure
-    REGIMES[4]: "#55a868",  # perforation
-}
-#: Line colours and styles of a study's runs, in order (black and dashed read in print).
-RUN_STYLES: list[dict[str, Any]] = [
-    {"color": "k", "ls": "-"},
-    {"color": "C3", "ls": "--"},
-    {"color": "C0", "ls": ":"},
-    {"color": "C2", "ls": "-."},
-    {"color": "C4", "ls": (0, (5, 1))},
-]
-
-
-def regime_colour(regime: Regime) -> str:
-    return REGIME_COLOURS.get(regime, "#999999")
-
-
-def regime_key(regimes: Sequence[Regime] | set[Regime]) -> list[Patch]:
-    """Legend handles: one coloured patch per regime present, in the order of REGIMES."""
-    return [Patch(color=regime_colour(r), label=r.label) for r in REGIMES if r in regimes]
 
 
 def _stretches(codes: np.ndarray) -> list[slice]:
@@ -262,96 +219,3 @@ def _draw_panel(
     for ax in axes[:2]:
         ax.tick_params(labelbottom=False)
     return drawn
-
-
-def plot_crater(
-    ax: Axes,
-    section: CraterSection,
-    *,
-    trajectory: Trajectory | None = None,
-    radius: float | None = None,
-    label: str | None = None,
-    **style: Any,
-) -> Axes:
-    """The crater floor, depth downward, in mm from the entry point; with ``trajectory``
-    and ``radius``, the centre's path and the sphere at first contact, deepest, last."""
-    ax.plot(section.lateral * 1e3, section.depth * 1e3, label=label, **style)
-    ax.axhline(0.0, color="0.3", lw=0.8)
-    if trajectory is not None and radius is not None:
-        shift = section.impact_point
-        centre_y = (trajectory.lateral + shift) * 1e3
-        centre_x = (trajectory.penetration - radius) * 1e3
-        ax.plot(centre_y, centre_x, ls=":", color="0.5", lw=0.8)
-        angles = np.linspace(0, 2 * np.pi, 181)
-        for i in (0, int(np.argmax(trajectory.penetration)), -1):
-            ax.plot(
-                centre_y[i] + radius * 1e3 * np.cos(angles),
-                centre_x[i] + radius * 1e3 * np.sin(angles),
-                color="0.6",
-                lw=0.6,
-            )
-    ax.set_xlabel("along the plate from entry [mm]")
-    ax.set_ylabel("depth [mm]")
-    ax.set_aspect("equal")
-    if not ax.yaxis_inverted():
-        ax.invert_yaxis()
-    return ax
-
-
-def plot_calibration(
-    ax: Axes,
-    shots: Shots,
-    dri: DriFit,
-    curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
-) -> Axes:
-    """Residual speed against impact speed, the layout of the report's Figure 11: the
-    shots (open markers: no perforation), the DRI fit (eq 40, dashed) and model curves.
-
-    ``curves`` maps a label to (impact speeds [m/s], residual speeds [m/s]).
-    """
-    perforated = shots.perforated
-    ax.plot(shots.impact_speed[perforated], shots.residual_speed[perforated], "ko", label="shots")
-    if not perforated.all():
-        ax.plot(
-            shots.impact_speed[~perforated],
-            shots.residual_speed[~perforated],
-            "ko",
-            mfc="none",
-            label="shots, no perforation",
-        )
-    for label, (speeds, residual) in curves.items():
-        ax.plot(speeds, residual, lw=1.2, label=label)
-    speeds = next(iter(curves.values()))[0] if curves else shots.impact_speed
-    grid = np.linspace(speeds.min(), speeds.max(), 300)
-    ax.plot(
-        grid,
-        dri.residual_speed(grid),
-        "k--",
-        lw=1,
-        label=f"DRI fit: R = {dri.R:.4g}, V0 = {dri.V0:.4g} m/s",
-    )
-    ax.set_xlabel("impact speed [m/s]")
-    ax.set_ylabel("residual speed [m/s]")
-    ax.set_ylim(bottom=0)
-    ax.legend(fontsize="small", loc="upper left")
-    return ax
-
-
-def figure_writer(
-    fig: Figure, path: str | os.PathLike[str], dpi: float = DPI
-) -> Callable[[IO[bytes]], object]:
-    """What writes ``fig`` to a binary handle in the format of ``path``'s extension (PNG,
-    SVG, PDF, ...) at ``dpi`` [dots per inch] for a raster: a figure with a layout
-    engine keeps its size (a PNG is ``dpi`` × its inches); one without is cropped to
-    what is drawn. For storage.output's writers (:func:`save`, a set of outputs)."""
-    if not DPI_RANGE[0] <= dpi <= DPI_RANGE[1]:  # also refuses NaN
-        raise ValueError(f"dpi must be from {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g}, got {dpi}")
-    suffix = Path(path).suffix.lower().lstrip(".")
-    crop = None if fig.get_layout_engine() else "tight"
-    return lambda handle: fig.savefig(handle, format=suffix, dpi=dpi, bbox_inches=crop)
-
-
-def save(fig: Figure, path: str | os.PathLike[str], flag: str = "figure", dpi: float = DPI) -> None:
-    """Save a figure (:func:`figure_writer`), all of it or nothing: written beside the
-    target and renamed over it (storage.output)."""
-    write_output(path, flag, figure_writer(fig, path, dpi), kind="figure")

@@ -25,7 +25,7 @@ from ..limits.lines import OBLIQUITY
 from ..limits.maps import OutcomeMap
 from ..limits.plate_limits import Limits
 from ..limits.regimes import REGIMES, Regime
-from .exit_curves import figure, regime_colour, regime_key
+from .style import figure, regime_colour, regime_key
 
 _DEG = math.pi / 180.0
 

@@ -12,7 +12,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..model.results import Outcome
-from .exit_curves import FONT, PAGE_WIDTH, SMALL, figure, short_run_name, study_panels
+from .exit_curves import short_run_name, study_panels
+from .style import FONT, PAGE_WIDTH, SMALL, figure
 
 if TYPE_CHECKING:
     from ..study.study import StudyResults

@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 
 from ..v50.fit import V50Fit
 from ..v50.mil_std import MilStd662F
-from .exit_curves import FONT, MAX_COLUMNS, PAGE_WIDTH, SMALL
+from .style import FONT, MAX_COLUMNS, PAGE_WIDTH, SMALL
 
 #: Points of the fitted curve; shots are drawn this far off 0 and 1 at most (jitter, so
 #: that shots at one speed stay apart), seeded so the figure is the same each time.

@@ -15,15 +15,8 @@ from ..experiment.validation import MEASURED, ValidationReport, measured_classes
 from ..model.batch import SceneBatch
 from ..run.simulation import Simulation
 from ..storage.shots import Shots
-from .exit_curves import (
-    FONT,
-    MAX_COLUMNS,
-    PAGE_WIDTH,
-    SMALL,
-    plot_exit_curves,
-    plot_outcome_strip,
-    regime_key,
-)
+from .exit_curves import plot_exit_curves, plot_outcome_strip
+from .style import FONT, MAX_COLUMNS, PAGE_WIDTH, SMALL, regime_key
 
 #: Model-curve points per obliquity.
 CURVE_POINTS = 300
