@@ -10,8 +10,9 @@ the forward hemisphere. Its projection on the contact plane is the presented are
 force acts along the contact-plane normal, at the inclination φ from the plate normal.
 
 Every function takes arrays (one value per scene) and broadcasts. All arccos/arcsin
-arguments are clamped to [−1, 1]: they leave it in legitimate states (model-notes §3),
-and the clamped values are the report's own special cases ("then Γe = 2π", "then Γs = 0").
+arguments are clamped to [−1, 1]: they leave it in legitimate states (docs/model.md §2,
+"Clamps"), and the clamped values are the report's own special cases ("then Γe = 2π",
+"then Γs = 0").
 For the plugging relief (eqs 9–13), call the same functions with P − h in place of P.
 """
 

@@ -79,7 +79,7 @@ class ImpactModel:
     failure: FailureModel = attrs.field(validator=_plugin_of(FailureModel))
     rest_speed_fraction: float = REST_SPEED_FRACTION.field()
 
-    #: Obliquity is held here once reached (model-notes §4): straight back out [rad].
+    #: Obliquity is held here once reached (docs/model.md §4, "θ = π"): straight back out [rad].
     MAX_OBLIQUITY: ClassVar[float] = np.pi
     #: θ = π is a stable equilibrium that θ approaches exponentially, ever faster as V
     #: falls, and never reaches: it counts as reached this close [rad] (docs/model.md,

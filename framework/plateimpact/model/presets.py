@@ -3,7 +3,7 @@
 Names are ``MATERIAL/THICKNESS_MM``. The 6061-T6 plate is listed as 9.52 mm in Table 1
 and 9.53 mm in the figures; its preset is named by the figures and keeps Table 1's
 thickness. Table 1 prints it under 2024-T3, but Figures 11–17 and 35 name it 6061-T6
-(model-notes §2). The report gives no sphere mass: the default sphere is SAE 52100 at
+(docs/model.md §9). The report gives no sphere mass: the default sphere is SAE 52100 at
 7830 kg/m³, 6.35 mm in diameter (1.0498 g).
 """
 
