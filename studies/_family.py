@@ -7,8 +7,7 @@ from pathlib import Path
 
 import plateimpact as pi
 from plateimpact.cli.common import dots_per_inch
-from plateimpact.figures import exit_curves, saving
-from plateimpact.figures import study_paths as path_figures
+from plateimpact.figures import exit_curves, saving, study_paths
 
 #: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]
@@ -41,7 +40,7 @@ def run_and_plot(
         overwrite=overwrite, run_names=tagged(study, tag),
     )  # fmt: skip
     if craters:
-        figure = path_figures.plot_study_paths(results, kind="crater")
+        figure = study_paths.plot_study_paths(results, kind="crater")
     else:
         figure = exit_curves.plot_study(results)
     path = out / f"{study.name}.{suffix}"
