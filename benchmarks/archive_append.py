@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import plateimpact as pi
-from plateimpact.storage.provenance import RunMetadata
+from plateimpact.provenance.metadata import RunMetadata
 
 
 def main() -> None:

@@ -14,7 +14,7 @@ import numpy as np
 from scenes import benchmark_batch
 
 import plateimpact as pi
-from plateimpact import events
+from plateimpact.solve import events
 
 
 def cubic(blur: float) -> int:

@@ -1,7 +1,7 @@
 """Would compiling the contact geometry pay? The numpy geometry against a numba loop.
 
 The force evaluation is the largest single cost of a sweep, and within it the contact
-geometry (eqs 2–6). This times ``plateimpact.geometry.contact_geometry`` on 10,000 random
+geometry (eqs 2–6). This times ``plateimpact.model.geometry.contact_geometry`` on 10,000 random
 states against the same formulas as one compiled loop per element (numba), after
 checking that the two agree. It is an experiment, not a second implementation: the
 package does not use it. Measured on the 2-core machine: numpy 1.24 ms, numba 1.11 ms
@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from plateimpact.geometry import HALF_PI, TWO_PI, contact_geometry
+from plateimpact.model.geometry import HALF_PI, TWO_PI, contact_geometry
 
 try:
     import numba

@@ -35,7 +35,7 @@ import numpy as np
 
 import plateimpact as pi
 from plateimpact import presets
-from plateimpact.results import Outcome
+from plateimpact.model.results import Outcome
 from plateimpact_plugins import PstarTable
 
 SPEED_SIGMA, RESIDUAL_SIGMA = 10.0, 5.0  # [m/s]

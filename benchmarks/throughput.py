@@ -23,7 +23,7 @@ import numpy as np
 from scenes import benchmark_batch
 
 import plateimpact as pi
-from plateimpact.crater import crater_section
+from plateimpact.model.crater import crater_section
 
 
 def best_of(function, repeats=5):

@@ -23,7 +23,7 @@ import time
 import numpy as np
 from scipy import stats
 
-from plateimpact.errors import V50Error
+from plateimpact.base.errors import V50Error
 from plateimpact.v50 import fit_v50
 
 TRUE_V50, TRUE_SIGMA = 500.0, 20.0  # [m/s]

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize, stats
 
-from plateimpact.errors import V50Error
+from plateimpact.base.errors import V50Error
 from plateimpact.storage.shots import Shots
 from plateimpact.v50 import fit_v50
 from plateimpact.v50.likelihood import LINKS, Estimate, GoNoGo, Link, check_shots, prepared

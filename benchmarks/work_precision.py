@@ -22,7 +22,7 @@ import numpy as np
 from scenes import benchmark_batch
 
 import plateimpact as pi
-from plateimpact import plotting
+from plateimpact.figures import saving, style
 
 RESULTS = Path(__file__).resolve().parent / "results"
 #: The reference's tolerance. solve_ivp steps across the force's branch surfaces (it has
@@ -147,15 +147,15 @@ def main() -> None:
 
 def plot(rows: list[tuple], scenes: int) -> None:
     """The work-precision diagram of ``rows`` (as in the CSV) into results/."""
-    fig, axes = plotting.figure(1, 2, figsize=(12, 4.8))
+    fig, axes = style.figure(1, 2, figsize=(12, 4.8))
     for series in dict.fromkeys(r[0] for r in rows):
         points = [r for r in rows if r[0] == series]
-        style = "s--" if "straddling" in series else "o-"
+        line = "s--" if "straddling" in series else "o-"
         for ax, column in zip(axes, (4, 6), strict=True):
             ax.loglog(
                 [max(float(r[column]), 1e-16) for r in points],
                 [float(r[9]) for r in points],
-                style,
+                line,
                 label=series,
             )
     axes[0].set_xlabel("max exit-speed error / impact speed")
@@ -170,7 +170,7 @@ def plot(rows: list[tuple], scenes: int) -> None:
         f"Work-precision, {scenes} scenes (reference: DOP853 at rtol {REFERENCE_RTOL:g}); "
         "dotted: the default's targets"
     )
-    plotting.save(fig, str(RESULTS / "work_precision.png"))
+    saving.save(fig, str(RESULTS / "work_precision.png"))
 
 
 if __name__ == "__main__":

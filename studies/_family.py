@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 import plateimpact as pi
-from plateimpact import path_figures, plotting
 from plateimpact.cli.common import dots_per_inch
+from plateimpact.figures import exit_curves, saving, study_paths
 
 #: Impact speeds of the figure families [m/s]: the report's figures span 0–1.5 km/s.
 SPEEDS = [50.0 + 10.0 * k for k in range(146)]
@@ -27,7 +27,7 @@ def run_and_plot(
     resume: bool = False,
     overwrite: bool = False,
     tag: str | None = None,
-    dpi: float = plotting.DPI,
+    dpi: float = saving.DPI,
     suffix: str = "png",
 ) -> Path:
     """Run ``study`` (appending its runs to ``archive``; with ``resume``, only those not
@@ -40,18 +40,18 @@ def run_and_plot(
         overwrite=overwrite, run_names=tagged(study, tag),
     )  # fmt: skip
     if craters:
-        figure = path_figures.plot_study_paths(results, kind="crater")
+        figure = study_paths.plot_study_paths(results, kind="crater")
     else:
-        figure = plotting.plot_study(results)
+        figure = exit_curves.plot_study(results)
     path = out / f"{study.name}.{suffix}"
-    plotting.save(figure, str(path), dpi=dpi)
+    saving.save(figure, str(path), dpi=dpi)
     return path
 
 
 def main(study: pi.Study, craters: bool = False) -> None:
     parser = argparse.ArgumentParser(description=study.description)
     parser.add_argument("--out", default=".", help="directory for the archive and the figure")
-    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--dpi", type=dots_per_inch, default=saving.DPI, help="PNG resolution")
     parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     args = parser.parse_args()
     out = Path(args.out)

@@ -23,15 +23,16 @@ from pathlib import Path
 from typing import Any
 
 import plateimpact as pi
-from plateimpact import limits, plotting, presets
-from plateimpact.errors import PlateImpactError
-from plateimpact.experiment.figure import validation_figure
-from plateimpact.storage.code_provenance import plugins_record
+from plateimpact import limits, presets
+from plateimpact.base.errors import PlateImpactError
+from plateimpact.base.untrusted import load_json
+from plateimpact.figures import saving
+from plateimpact.figures.v50_fits import Panel, v50_figure
+from plateimpact.figures.validation_panels import validation_figure
+from plateimpact.provenance.code import plugins_record
+from plateimpact.provenance.metadata import versions
+from plateimpact.provenance.source_hash import module_sources, source_sha256
 from plateimpact.storage.output import write_text
-from plateimpact.storage.provenance import versions
-from plateimpact.storage.source_hash import module_sources, source_sha256
-from plateimpact.untrusted import load_json
-from plateimpact.v50.figure import Panel, v50_figure
 
 DATA = Path(__file__).resolve().parent / "data"
 PLATE = "SAE1010/1.47"
@@ -52,7 +53,7 @@ PROVENANCE = "experiment_provenance.json"
 
 def provenance() -> dict[str, Any]:
     """The code and data the outputs depend on: every module of plateimpact and of the
-    studies this one imports (hashed as storage.code_provenance hashes a plug-in), the
+    studies this one imports (hashed as provenance.code hashes a plug-in), the
     models' plug-ins and core, the package versions, and the shot files' SHA-256."""
     # The tools it reaches as pi.NAME (imported on first use, so not read as imports)
     # are roots beside it.
@@ -90,7 +91,7 @@ def outputs(out: Path, suffix: str = "png") -> list[Path]:
 
 def experiment(
     out: Path,
-    dpi: float = plotting.DPI,
+    dpi: float = saving.DPI,
     suffix: str = "png",
     resume: bool = False,
     quick: bool = False,
@@ -116,7 +117,7 @@ def experiment(
         report = pi.validate(simulation, sphere, plate, shots)
         title = (f"{PLATE}, {name} model against {OBLIQUE.name} (synthetic): "
                  f"outcome agreement {report.agreement:.1%}")  # fmt: skip
-        plotting.save(validation_figure(report, simulation, title=title), str(path), dpi=dpi)
+        saving.save(validation_figure(report, simulation, title=title), str(path), dpi=dpi)
     if not (resume and v50.exists()):
         go_no_go = pi.Shots.from_csv(GO_NO_GO).groups_by_obliquity()
         bootstrap = {"bootstrap": QUICK_BOOTSTRAP} if quick else {}
@@ -131,7 +132,7 @@ def experiment(
         ]  # fmt: skip
         title = f"{GO_NO_GO.name} (synthetic)"
         figure = v50_figure(panels, title=title, model=f"{PLATE}, plugging")
-        plotting.save(figure, str(v50), dpi=dpi)
+        saving.save(figure, str(v50), dpi=dpi)
     if not (resume and table.exists()):
         # Boundaries to 0.1 m/s (no band of 4 m/s missed) are 30 times finer than the
         # shots' 3 m/s speed noise and the fit's 10 m/s scatter; the P* found differ

@@ -22,8 +22,9 @@ from pathlib import Path
 import numpy as np
 
 import plateimpact as pi
-from plateimpact import limits, plotting, presets
-from plateimpact.crater import crater_section
+from plateimpact import limits, presets
+from plateimpact.figures import crater_sections, exit_curves, saving, style
+from plateimpact.model.crater import crater_section
 from plateimpact.units import deg, mm
 from plateimpact_plugins import Hinge
 
@@ -42,24 +43,24 @@ def figure_30_31(out: Path) -> Path:
         description=f"Figures 30-31, P* = {pstar / mm:g} mm against a plate that never fails",
     )
     path = out / "fig30_31_2024T3_3.18mm_60deg.png"
-    plotting.save(plotting.plot_study(study.run()), str(path))
+    saving.save(exit_curves.plot_study(study.run()), str(path))
     return path
 
 
 def figure_35(out: Path) -> Path:
     plate = presets.plate("6061-T6/9.53")
     simulation = pi.Simulation.from_names()
-    fig, axes = plotting.figure(2, 1, figsize=(8, 7), layout="constrained")
+    fig, axes = style.figure(2, 1, figsize=(8, 7), layout="constrained")
     for ax, speed in zip(axes, (263.0, 737.0), strict=True):
         result = simulation.run(pi.Scene(SPHERE, plate, speed, 60 * deg), record_trajectory=True)
         section = crater_section(result.trajectory, SPHERE.radius, thickness=plate.thickness)
-        plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=SPHERE.radius)
+        crater_sections.plot_crater(ax, section, trajectory=result.trajectory, radius=SPHERE.radius)
         ax.set_title(
             f"6061-T6, 9.53 mm, 60°, {speed / 1e3:.3f} km/s: {result.outcome.label}, "
             f"crater {section.length / mm:.1f} × {section.max_depth / mm:.2f} mm"
         )
     path = out / "fig35_craters_6061T6_9.53mm_60deg.png"
-    plotting.save(fig, str(path))
+    saving.save(fig, str(path))
     return path
 
 
@@ -85,7 +86,7 @@ def hinge_geometry(out: Path) -> Path:
         (failed[-1], "perforation"),
     ]
     h = batch.failure_plane_depth[0]
-    fig, axes = plotting.figure(1, 3, figsize=(13, 4.6))
+    fig, axes = style.figure(1, 3, figsize=(13, 4.6))
     rs = SPHERE.radius / mm
     circle = np.linspace(0, 2 * np.pi, 241)
     for ax, (i, title) in zip(axes, moments, strict=True):
@@ -143,22 +144,22 @@ def hinge_geometry(out: Path) -> Path:
         fontsize=10,
     )
     path = out / "hinge_geometry.png"
-    plotting.save(fig, str(path))
+    saving.save(fig, str(path))
     return path
 
 
 def outcome_map(out: Path) -> Path:
-    from plateimpact.limits.figures import plot_outcome_map  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_outcome_map  # noqa: PLC0415
 
     plate = presets.plate("2024-T3/3.18")
     found = limits.outcome_map(pi.Simulation.from_names(), SPHERE, plate)
     path = out / "outcome_map_2024T3_3.18mm.png"
-    plotting.save(plot_outcome_map([("2024-T3, 3.18 mm", found)]), str(path))
+    saving.save(plot_outcome_map([("2024-T3, 3.18 mm", found)]), str(path))
     return path
 
 
 def limit_curves(out: Path) -> Path:
-    from plateimpact.limits.figures import plot_limit_curves  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_limit_curves  # noqa: PLC0415
 
     simulation = pi.Simulation.from_names()
     maps = [
@@ -166,7 +167,7 @@ def limit_curves(out: Path) -> Path:
         for name in presets.PLATES
     ]
     path = out / "limit_curves.png"
-    plotting.save(plot_limit_curves(maps), str(path))
+    saving.save(plot_limit_curves(maps), str(path))
     return path
 
 

@@ -19,10 +19,11 @@ from pathlib import Path
 import numpy as np
 
 import plateimpact as pi
-from plateimpact import limits, plotting, presets
+from plateimpact import limits, presets
 from plateimpact.cli.common import dots_per_inch
-from plateimpact.storage.code_provenance import limits_record, plugins_record
-from plateimpact.storage.reruns import check_code
+from plateimpact.figures import saving
+from plateimpact.provenance.code import limits_record, plugins_record
+from plateimpact.study.reruns import check_code
 
 try:
     from . import (
@@ -100,7 +101,7 @@ def outcome_maps(
     resume: bool = False,
     overwrite: bool = False,
     tag: str | None = None,
-    dpi: float = plotting.DPI,
+    dpi: float = saving.DPI,
     suffix: str = "png",
     quick: bool = False,
 ) -> tuple[list[limits.OutcomeMap], list[Path]]:
@@ -109,7 +110,7 @@ def outcome_maps(
     if there; with ``overwrite``, replaced), and drawn: ``outcome_maps.<suffix>`` and
     ``limit_curves.<suffix>`` (at ``dpi`` [dots per inch] if a raster); ``quick``: on
     the small grid of --quick."""
-    from plateimpact.limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     names = map_names(tag)
     stored = kept_maps(archive, names) if resume else set()
@@ -128,8 +129,8 @@ def outcome_maps(
                 limits.archive_limits(archive, name, drawn, overwrite=overwrite)
     maps = list(zip(presets.PLATES, found, strict=True))
     paths = [out / f"outcome_maps.{suffix}", out / f"limit_curves.{suffix}"]
-    plotting.save(plot_outcome_map(maps), str(paths[0]), dpi=dpi)
-    plotting.save(plot_limit_curves(maps), str(paths[1]), dpi=dpi)
+    saving.save(plot_outcome_map(maps), str(paths[0]), dpi=dpi)
+    saving.save(plot_limit_curves(maps), str(paths[1]), dpi=dpi)
     return found, paths
 
 
@@ -139,7 +140,7 @@ def reproduce(
     resume: bool = False,
     overwrite: bool = False,
     tag: str | None = None,
-    dpi: float = plotting.DPI,
+    dpi: float = saving.DPI,
     suffix: str = "png",
     quick: bool = False,
 ) -> tuple[Path, list[Path]]:
@@ -177,7 +178,7 @@ def main() -> None:
     rerun.add_argument("--resume", action="store_true", help="run only the missing runs")
     rerun.add_argument("--overwrite", action="store_true", help="replace the runs there")
     rerun.add_argument("--as", dest="tag", metavar="TAG", help="store new runs as VARIANT@TAG")
-    parser.add_argument("--dpi", type=dots_per_inch, default=plotting.DPI, help="PNG resolution")
+    parser.add_argument("--dpi", type=dots_per_inch, default=saving.DPI, help="PNG resolution")
     parser.add_argument("--format", choices=("png", "svg", "pdf"), default="png")
     parser.add_argument("--quick", action="store_true", help="small grids: a smoke test")
     args = parser.parse_args()

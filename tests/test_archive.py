@@ -14,8 +14,8 @@ import pytest
 
 import plateimpact as pi
 from plateimpact.cli import main as cli
-from plateimpact.crater import crater_section
 from plateimpact.limits import stored_limits
+from plateimpact.model.crater import crater_section
 
 SPEEDS = np.linspace(150.0, 1200.0, 8)
 
@@ -128,14 +128,14 @@ KILL_SCRIPT = """
 import os, signal, sys
 import numpy as np
 import plateimpact as pi
-import plateimpact.simulation
-run_chunk, calls = plateimpact.simulation.run_chunk, [0]
+import plateimpact.run.simulation
+run_chunk, calls = plateimpact.run.simulation.run_chunk, [0]
 def chunk(*args, **kwargs):
     calls[0] += 1
     if calls[0] == 5:  # the second run's second chunk of three: killed there, not timed
         os.kill(os.getpid(), signal.SIGKILL)
     return run_chunk(*args, **kwargs)
-plateimpact.simulation.run_chunk = chunk
+plateimpact.run.simulation.run_chunk = chunk
 study = pi.Study.grid(
     "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20),
     [pi.Variant("fast"),

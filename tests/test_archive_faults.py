@@ -24,10 +24,10 @@ from test_output_files import assert_one_line, mounted, run_cli
 from test_output_flags import CALIBRATE, SCENE
 
 import plateimpact as pi
-from plateimpact import limits, presets, simulation
+from plateimpact import limits, presets
 from plateimpact.cli import archive_commands
-from plateimpact.export import declared_column, netcdf_bytes
 from plateimpact.storage import upgrade as upgrading
+from plateimpact.storage.export import declared_column, netcdf_bytes
 from plateimpact.storage.lock import ArchiveBusyError, locked
 from plateimpact.storage.netcdf import write_run_file
 
@@ -274,7 +274,7 @@ def _no_run(*args, **kwargs):
 
 
 def test_an_archive_whose_temporaries_would_not_fit_is_refused_first(tmp_path, monkeypatch):
-    monkeypatch.setattr(simulation, "run_chunk", _no_run)
+    monkeypatch.setattr("plateimpact.run.simulation.run_chunk", _no_run)
     for length, words in [(240, "NAME_MAX"), (300, "NAME_MAX")]:
         path = tmp_path / ("x" * (length - 3) + ".h5")
         with pytest.raises(pi.ArchiveError, match=words):
@@ -300,7 +300,7 @@ def deep(tmp_path_factory) -> Path:
 
 
 def test_a_path_over_path_max_is_one_line_from_the_api(deep, monkeypatch):
-    monkeypatch.setattr(simulation, "run_chunk", _no_run)
+    monkeypatch.setattr("plateimpact.run.simulation.run_chunk", _no_run)
     with pytest.raises(pi.ArchiveError, match="PATH_MAX"):
         tiny_study().run(archive=deep / "a.h5")
     with pytest.raises(pi.ArchiveError, match="PATH_MAX"):
@@ -380,6 +380,6 @@ def test_a_read_only_filesystem_is_one_line_naming_the_flag(
 
 
 def test_study_run_on_a_read_only_filesystem_is_one_line(read_only, monkeypatch):
-    monkeypatch.setattr(simulation, "run_chunk", _no_run)
+    monkeypatch.setattr("plateimpact.run.simulation.run_chunk", _no_run)
     with pytest.raises(pi.ArchiveError, match="read-only"):
         tiny_study().run(archive=read_only / "a.h5")

@@ -21,9 +21,9 @@ import pytest
 from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
-from plateimpact import limits, presets, simulation
+from plateimpact import limits, presets
 from plateimpact.cli import archive_commands
-from plateimpact.limits.records import attributes_of
+from plateimpact.limits.archived import attributes_of
 from plateimpact.storage import lock as locking
 from plateimpact.storage.output import write_text
 
@@ -121,7 +121,7 @@ def test_a_shipped_lock_is_never_written_and_refused_before_any_run(archive, mak
     notes.write_bytes(NOTES)
     make(archive.with_name("a.h5.lock"), notes)
     before = archive.read_bytes()
-    monkeypatch.setattr(simulation, "run_chunk", _no_run)  # refused before any scene runs
+    monkeypatch.setattr("plateimpact.run.simulation.run_chunk", _no_run)  # refused before any run
     with pytest.raises(pi.ArchiveError, match=r"lock .*a\.h5\.lock is (a symbolic|a second|not a)"):
         tiny_study(variant="new").run(archive=archive)
     code, _, err = run_cli(["limits", "--preset", "2024-T3/3.18", "--obliquities", "0",
@@ -372,7 +372,7 @@ def test_a_renamed_archive_takes_new_runs_in_its_existing_study(archive, monkeyp
     )
     data_file(renamed, "w/runs/new").unlink()  # refused before any scene runs
     data_file(renamed, "w/scenes").unlink()
-    monkeypatch.setattr(simulation, "run_chunk", _no_run)
+    monkeypatch.setattr("plateimpact.run.simulation.run_chunk", _no_run)
     with pytest.raises(pi.ArchiveError, match="is missing"):
         study.run(archive=renamed, overwrite=True)
 

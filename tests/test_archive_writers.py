@@ -152,7 +152,7 @@ for k in range(5):  # waiting as long as it takes: no clock decides where a run 
 """
 
 
-@pytest.mark.filterwarnings("ignore::plateimpact.errors.ArchiveWaitWarning")
+@pytest.mark.filterwarnings("ignore::plateimpact.base.errors.ArchiveWaitWarning")
 def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
     path = tmp_path / "a.h5"
     link = tmp_path / "link.h5"

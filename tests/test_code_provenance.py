@@ -24,12 +24,12 @@ import pytest
 from conftest import THIRD_PARTY
 
 import plateimpact as pi
-import plateimpact.simulation as simulation_module
+import plateimpact.run.simulation as simulation_module
 from plateimpact import limits, presets
 from plateimpact.cli import main
-from plateimpact.storage import code_provenance
-from plateimpact.storage.reruns import StaleRunError
+from plateimpact.provenance import code as code_provenance
 from plateimpact.storage.upgrade import upgrade
+from plateimpact.study.reruns import StaleRunError
 
 PACKAGE = "plateimpact_isotropic"
 BUILTINS = Path(__file__).resolve().parents[1] / "plugins" / "plateimpact_plugins"
@@ -241,7 +241,11 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
     assert record["integrator"]["class"] == "plateimpact_plugins.segment.Segment"
     assert record["integrator"]["distribution"] == "plateimpact"
     core = record["core"]["source_modules"]
-    assert {"plateimpact.simulation", "plateimpact.model", "plateimpact.driver"} <= set(core)
+    assert {
+        "plateimpact.run.simulation",
+        "plateimpact.model.impact",
+        "plateimpact.solve.driver",
+    } <= set(core)
     assert not any(m.startswith(("plateimpact.cli", "plateimpact.storage")) for m in core)
     # run --json (and so sweep's FILE.json) and the archive's run attribute.
     argv = ["run", "--preset", "2024-T3/3.18", "--speed", "640", "--obliquity", "60"]
@@ -267,9 +271,9 @@ def test_stored_limits_keep_their_record_and_older_ones_read_without_it(tmp_path
     assert found.plugins["limits"]["source_modules"][-1] == "plateimpact.limits.regimes"
     limits.archive_limits(tmp_path / "a.h5", "l", found)
     assert limits.read_limits(tmp_path / "a.h5", "l").plugins == found.plugins
-    record = limits.records.to_record(found)
+    record = limits.archived.to_record(found)
     del record.attributes["plugins"]  # as written before plug-in provenance was
-    assert limits.records.from_record(record).plugins is None
+    assert limits.archived.from_record(record).plugins is None
 
 
 def test_hashes_are_computed_once_per_class_and_process(monkeypatch):

@@ -17,7 +17,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import presets
-from plateimpact.results import RESULT_FIELDS
+from plateimpact.model.results import RESULT_FIELDS
 
 ROOT = Path(__file__).resolve().parents[1]
 SPHERE = presets.DEFAULT_SPHERE

@@ -23,14 +23,14 @@ import plateimpact as pi
 
 SCRIPT = """
 import os, signal, sys
-import plateimpact.simulation
+import plateimpact.run.simulation
 from plateimpact.storage import append
 sys.path.insert(0, {tests!r})
 from test_crash_safety import CHUNK, study
 
 kind, where = sys.argv[2], sys.argv[3:]
 chunks, appends = [0], [0]
-run_chunk = plateimpact.simulation.run_chunk
+run_chunk = plateimpact.run.simulation.run_chunk
 
 def die():
     os.kill(os.getpid(), signal.SIGKILL)
@@ -47,7 +47,7 @@ def fault_point(stage):
     if kind == "append" and appends[0] == int(where[0]) and stage == where[1]:
         die()
 
-plateimpact.simulation.run_chunk = counted_chunk
+plateimpact.run.simulation.run_chunk = counted_chunk
 append.fault_point = fault_point
 study().run(archive=sys.argv[1], chunk_size=CHUNK)
 """

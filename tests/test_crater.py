@@ -7,7 +7,7 @@ import pytest
 
 import plateimpact as pi
 from plateimpact import presets
-from plateimpact.crater import crater_section
+from plateimpact.model.crater import crater_section
 from plateimpact.units import deg
 
 RS = presets.DEFAULT_SPHERE.radius

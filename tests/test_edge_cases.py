@@ -107,7 +107,7 @@ def test_pstar_on_a_branch_of_the_contact_geometry_is_continuous(pstar_over_radi
 
 
 def test_the_direction_at_rest_converges_for_every_integrator():
-    """An embedment that still turns as V → 0 (the singularity of model-notes §4): with
+    """An embedment that still turns as V → 0 (the singularity of docs/model.md §4, "Rest"): with
     the rest rule its final direction is a property of the model, not of the step: the
     segment method converges to it at first order, and the adaptive methods agree."""
     scene = pi.Scene(SPHERE, presets.plate("6061-T6/9.53"), 800.0, 45 * deg)

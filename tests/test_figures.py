@@ -14,8 +14,8 @@ import pytest
 from matplotlib.colors import to_rgba
 
 import plateimpact as pi
-from plateimpact import plotting
 from plateimpact.cli import main as cli
+from plateimpact.figures import exit_curves, style
 from plateimpact.limits import Regime, regime_codes
 
 SPEEDS = np.arange(50.0, 1501.0, 50.0)  # 30 speeds: every outcome of the 3.18-mm plate
@@ -52,14 +52,14 @@ def curve_lines(ax):
 
 def run_of(line, runs):
     """The run a line belongs to, by its style (RUN_STYLES: one colour per run)."""
-    colours = [to_rgba(plotting.RUN_STYLES[k]["color"]) for k in range(len(runs))]
+    colours = [to_rgba(style.RUN_STYLES[k]["color"]) for k in range(len(runs))]
     return runs[colours.index(to_rgba(line.get_color()))]
 
 
 @pytest.mark.parametrize("count", [1, 3, 4, 5, 8])
 def test_the_panels_form_a_grid_of_at_most_four_columns(count):
     study = pi.Study.grid("g", ["2024-T3/3.18"], EIGHT[:count], SPEEDS[::6], pi.Variant("v"))
-    fig = plotting.plot_study(study.run())
+    fig = exit_curves.plot_study(study.run())
     speed_axes = fig.axes[::3]
     assert len(speed_axes) == count
     rows = {ax.get_subplotspec().rowspan.start // 3 for ax in speed_axes}
@@ -70,7 +70,7 @@ def test_the_panels_form_a_grid_of_at_most_four_columns(count):
 
 
 def test_the_key_names_every_run_and_every_outcome_present(eight_obliquities):
-    fig = plotting.plot_study(eight_obliquities)
+    fig = exit_curves.plot_study(eight_obliquities)
     (legend,) = fig.legends
     labels = [text.get_text() for text in legend.get_texts()]
     assert labels[:2] == ["plugging", "intact"]
@@ -94,9 +94,9 @@ def key_colours(legend):
 
 
 def test_the_family_key_and_the_outcome_maps_share_one_palette(eight_obliquities):
-    from plateimpact.limits.figures import plot_bands  # noqa: PLC0415
+    from plateimpact.figures.limits_and_maps import plot_bands  # noqa: PLC0415
 
-    family = key_colours(plotting.plot_study(eight_obliquities).legends[0])
+    family = key_colours(exit_curves.plot_study(eight_obliquities).legends[0])
     found = pi.limits.along_speed(
         pi.Simulation.from_names(), pi.presets.DEFAULT_SPHERE,
         pi.presets.plate("2024-T3/3.18"), np.radians([0.0, 60.0]), resolution=40.0,
@@ -110,7 +110,7 @@ def test_the_family_key_and_the_outcome_maps_share_one_palette(eight_obliquities
 def test_no_line_joins_two_outcomes_and_embedments_are_not_lines(eight_obliquities):
     results = eight_obliquities
     runs = list(results.runs)
-    fig = plotting.plot_study(results)
+    fig = exit_curves.plot_study(results)
     drawn = 0
     for ob in EIGHT:
         speed_ax, obliquity_ax, _ = panels_of(fig)[f"2024-T3/3.18, {ob}°"]
@@ -134,8 +134,8 @@ def test_exit_curves_break_at_every_regime_change():
         pi.presets.DEFAULT_SPHERE, pi.presets.plate("2024-T3/6.35"), speeds, np.radians([45.0])
     )
     result = pi.Simulation.from_names().run_batch(batch)
-    fig, axes = plotting.figure(2, 1)
-    plotting.plot_exit_curves(axes, speeds, result, label="run")
+    fig, axes = style.figure(2, 1)
+    exit_curves.plot_exit_curves(axes, speeds, result, label="run")
     codes = regime_codes(result)
     drawn = [np.searchsorted(speeds, line.get_xdata()) for line in axes[0].get_lines()]
     stretches = np.split(np.arange(codes.size), np.flatnonzero(np.diff(codes)) + 1)
@@ -148,7 +148,7 @@ def test_exit_curves_break_at_every_regime_change():
 
 def test_the_strips_show_every_runs_outcome_at_every_scene(eight_obliquities):
     results = eight_obliquities
-    fig = plotting.plot_study(results)
+    fig = exit_curves.plot_study(results)
     for ob in (0, 30, 60):
         strip = panels_of(fig)[f"2024-T3/3.18, {ob}°"][2]
         index = panel_scenes(results, ob)
@@ -162,7 +162,7 @@ def test_the_strips_show_every_runs_outcome_at_every_scene(eight_obliquities):
             bars.append((x0, x1, 0.5 * (y0 + y1), tuple(collection.get_facecolor()[0])))
         for row, run in enumerate(results.runs):
             for speed, code in zip(speeds, regime_codes(results[run])[index], strict=True):
-                colour = to_rgba(plotting.REGIME_COLOURS[Regime.of_code(code)])
+                colour = to_rgba(style.REGIME_COLOURS[Regime.of_code(code)])
                 covering = [b for b in bars if b[0] <= speed <= b[1] and round(b[2]) == row]
                 assert covering and all(b[3] == colour for b in covering), (ob, run, speed)
 
@@ -170,7 +170,7 @@ def test_the_strips_show_every_runs_outcome_at_every_scene(eight_obliquities):
 def test_normal_incidence_says_what_the_obliquity_is_instead_of_a_flat_line(
     eight_obliquities,
 ):
-    fig = plotting.plot_study(eight_obliquities)
+    fig = exit_curves.plot_study(eight_obliquities)
     _, obliquity_ax, _ = panels_of(fig)["2024-T3/3.18, 0°"]
     assert not curve_lines(obliquity_ax)
     (note,) = obliquity_ax.texts
@@ -275,11 +275,11 @@ def test_panels_with_no_exit_or_one_speed_are_drawn_and_say_so():
     embedded = pi.Study.grid("e", ["6061-T6/9.53"], [0], [100.0, 200.0, 300.0], pi.Variant("v"))
     results = embedded.run()
     assert np.all(results["v"].outcome == pi.Outcome.EMBEDMENT)
-    speed_ax, obliquity_ax, strip = plotting.plot_study(results).axes
+    speed_ax, obliquity_ax, strip = exit_curves.plot_study(results).axes
     assert not curve_lines(speed_ax) and not curve_lines(obliquity_ax)
     assert "no sphere leaves the plate" in obliquity_ax.texts[0].get_text()
     assert len(strip.collections) == 1  # one embedment bar over the three speeds
     one = pi.Study.grid("o", ["2024-T3/3.18"], [45], [900.0], pi.Variant("v")).run()
-    speed_ax, _, strip = plotting.plot_study(one).axes
+    speed_ax, _, strip = exit_curves.plot_study(one).axes
     (dot,) = curve_lines(speed_ax)
     assert dot.get_marker() == "." and list(dot.get_xdata()) == [900.0]

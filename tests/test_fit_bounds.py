@@ -15,11 +15,11 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import presets
+from plateimpact.base.errors import WorkBoundError
 from plateimpact.calibration import pstar_plan, pstar_search
 from plateimpact.calibration.outcome_model import ProbabilityModel, ShotLines
-from plateimpact.errors import WorkBoundError
 from plateimpact.limits import chunked
-from plateimpact.results import Outcome
+from plateimpact.model.results import Outcome
 
 PLATE = presets.plate("2024-T3/3.18")
 FAST = {"resolution": 4.0, "tolerance": 0.25}
@@ -170,7 +170,7 @@ def test_a_fit_runs_a_chunk_at_a_time_and_keeps_no_samples_per_candidate(tmp_pat
     simulation = pi.Simulation.from_names(integrator_settings={"rtol": 1e-6})
     model = ProbabilityModel(10.0, residual_sigma=5.0)
     told: list[int] = []
-    monkeypatch.setattr("plateimpact.simulation.report_scenes", told.append)
+    monkeypatch.setattr("plateimpact.run.simulation.report_scenes", told.append)
     whole = pi.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
     assert whole.residual_shots == 4
     assert max(told) == 17 * 34  # the scan of 17 candidates, one batch

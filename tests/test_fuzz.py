@@ -111,7 +111,7 @@ def check_archive(files: ArchiveFiles, damaged: str, data: bytes) -> None:
         try:  # the Python API raises ArchiveError (or reads the run back whole)
             result = pi.Archive(path).results("v")
             assert len(result) == 8
-        except (pi.ArchiveError, pi.errors.UnknownNameError):
+        except (pi.ArchiveError, pi.UnknownNameError):
             pass
 
 
@@ -166,7 +166,7 @@ def test_bit_flipped_archives_with_limits_give_one_line_errors(limits_archive_fi
             assert_clean(*run_cli([argv[0], str(path), *argv[1:]]))
         try:  # the Python API raises ArchiveError (or reads the limits back whole)
             assert len(limits.read_limits(path, "l").lines) == 2
-        except (pi.ArchiveError, pi.errors.UnknownNameError):
+        except (pi.ArchiveError, pi.UnknownNameError):
             pass
 
 

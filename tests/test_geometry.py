@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.special import roots_legendre
 
-from plateimpact.geometry import (
+from plateimpact.model.geometry import (
     branch_margins,
     contact_geometry,
     contact_lost_margin,

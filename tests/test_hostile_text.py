@@ -1,7 +1,7 @@
 """Text from someone else's file never acts on the terminal: names, descriptions, hosts,
 versions, plate labels and materials of an archive, a plate file's keys, a shot file's
 cells, an inputs record's label, a P* table's header. Each prints as one inert line
-(plateimpact.untrusted.printable: new lines, escape sequences, carriage returns and
+(plateimpact.base.untrusted.printable: new lines, escape sequences, carriage returns and
 bidirectional overrides escaped), in ``show``, ``compare``, ``run``, ``validate``, ``v50``
 and every error message; no forged ``plateimpact: error:`` line ever starts a line.
 
@@ -23,10 +23,10 @@ import pytest
 
 import plateimpact as pi
 from plateimpact import limits, presets
+from plateimpact.base.errors import PlateImpactError, PlateImpactWarning
+from plateimpact.base.untrusted import spreadsheet_safe
 from plateimpact.cli import main
-from plateimpact.errors import PlateImpactError, PlateImpactWarning
 from plateimpact.storage.hdf5 import seal
-from plateimpact.untrusted import spreadsheet_safe
 
 #: A new line that forges an error line, an escape sequence, a carriage return and a
 #: right-to-left override.

@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 
 import plateimpact as pi
-from plateimpact import calibration, driver, presets
+from plateimpact import calibration, presets
 from plateimpact.calibration.start import log_domain
 from plateimpact.cli import main
+from plateimpact.solve import driver
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/3.18")

@@ -16,8 +16,8 @@ import pytest
 
 import plateimpact as pi
 from plateimpact import cli, presets
+from plateimpact.base.errors import ParameterError
 from plateimpact.cli import main
-from plateimpact.errors import ParameterError
 from plateimpact.storage.plate_file import plate_to_dict
 from plateimpact_plugins.plugging import Plugging
 

@@ -1,9 +1,13 @@
-"""The package's shape: import layers without cycles, short modules, cheap imports.
+"""The package's shape: its folders are its layers, imported downward without cycles;
+short modules; cheap imports.
 
-Layers, lowest first: physics (the model's data, geometry, interfaces, the model) <-
-running (driver, steppers' interface, registry, simulation) <- storage (archives, plate
-and shot files) <- analysis (studies, calibration, plotting) <- cli. A module imports its
-own layer or lower ones, never the package root, never the built-in plug-ins.
+Each folder of the core is one layer or one capability, and a module's layer is its
+folder's name. LAYERS orders the folders, lowest first; the folders of one entry share a
+layer (the analysis capabilities). A module imports its own folder or a lower layer's,
+never a higher one, never the package root (the root re-exports, lazily: it and the
+``units`` module beside it are the public face, which nothing inside imports), never the
+built-in plug-ins or the studies. Folders that share a layer import one another without a
+cycle.
 """
 
 from __future__ import annotations
@@ -18,24 +22,21 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "framework" / "plateimpact"
-LAYERS = {
-    "physics": {
-        "units", "errors", "untrusted", "parameters", "bodies", "scene", "batch", "geometry",
-        "plugin", "resistance", "failure", "binding", "model", "results", "ragged", "crater",
-        "presets",
-    },
-    "running": {
-        "dense", "dynamics", "integrator", "control", "events", "recorder", "driver",
-        "hookspecs", "discovery", "registry", "simulation", "variant", "progress",
-    },
-    "storage": {"storage"},
-    "analysis": {
-        "study", "comparison", "calibration", "plotting", "path_figures", "limits", "export",
-        "experiment", "v50",
-    },
-    "cli": {"cli"},
-}  # fmt: skip
-ORDER = list(LAYERS)
+#: The folders of the core, lowest layer first.
+LAYERS: list[tuple[str, ...]] = [
+    ("base",),  # unit factors, errors, untrusted input, declarations of parameters
+    ("model",),  # bodies, scenes, geometry, the physics' plug-in contracts, the model
+    ("solve",),  # the integrator contract, the driver, step control, events
+    ("registry",),  # the plug-ins' hook, discovery, the registry
+    ("run",),  # simulations, variants, progress
+    ("storage",),  # archives, netCDF, locks, plate and shot files, outputs, export
+    ("provenance",),  # what produced a result: inputs, versions, the code's hashes
+    ("study", "limits", "v50", "calibration", "experiment", "comparison"),  # analysis
+    ("figures",),  # every figure
+    ("cli",),  # the command line
+]
+#: The package root: its lazy re-exports and the documented ``plateimpact.units``.
+PUBLIC_FACE = ("plateimpact", "plateimpact.units")
 LONGEST_MODULE = 400  # lines
 
 
@@ -76,48 +77,83 @@ GRAPH = {
 }
 
 
-def layer_of(name: str) -> str:
-    top = name.split(".")[1]
-    return next(layer for layer, members in LAYERS.items() if top in members)
+def folder_of(name: str) -> str:
+    """The folder a module of the core is in (its layer's name)."""
+    return name.split(".")[1]
 
 
-def test_every_module_has_a_layer():
-    inner = [name for name in CORE_MODULES if name != "plateimpact"]
-    assert all(layer_of(name) for name in inner)
+def layer_of(name: str) -> int:
+    return next(i for i, folders in enumerate(LAYERS) if folder_of(name) in folders)
+
+
+def test_every_folder_is_a_layer_and_every_module_is_in_a_folder():
+    folders = {p.name for p in CORE.iterdir() if (p / "__init__.py").is_file()}
+    assert folders == {folder for layer in LAYERS for folder in layer}
+    loose = {p.stem for p in CORE.glob("*.py")} - {"__init__"}
+    assert {f"plateimpact.{stem}" for stem in loose} == set(PUBLIC_FACE) - {"plateimpact"}
 
 
 def test_no_module_imports_a_higher_layer_or_the_package_root():
     wrong = []
     for name, imported in GRAPH.items():
-        if name == "plateimpact":
-            continue  # the root re-exports everything, lazily
+        if name in PUBLIC_FACE:
+            continue  # the public face re-exports every layer
         for target in imported:
-            if target == "plateimpact" or not target.startswith("plateimpact."):
+            if target in PUBLIC_FACE or not target.startswith("plateimpact."):
                 wrong.append((name, target))
-            elif ORDER.index(layer_of(target)) > ORDER.index(layer_of(name)):
+            elif layer_of(target) > layer_of(name):
                 wrong.append((name, target))
     assert not wrong
 
 
-def test_no_import_cycles():
-    graph = {
-        n: {m for m in deps if m in CORE_MODULES and m != "plateimpact"}
-        for n, deps in GRAPH.items()
-    }
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """A cycle of ``graph`` (node -> the nodes it imports), or None."""
     state: dict[str, int] = {}  # 1 on the current path, 2 done
 
-    def visit(node: str, path: list[str]) -> None:
+    def visit(node: str, path: list[str]) -> list[str] | None:
         state[node] = 1
-        for nxt in graph[node]:
+        for nxt in sorted(graph.get(node, ())):
             if state.get(nxt) == 1:
-                pytest.fail("import cycle: " + " -> ".join(path[path.index(nxt) :] + [nxt]))
-            if nxt not in state:
-                visit(nxt, [*path, nxt])
+                return path[path.index(nxt) :] + [nxt]
+            if nxt not in state and (cycle := visit(nxt, [*path, nxt])):
+                return cycle
         state[node] = 2
+        return None
 
-    for node in graph:
-        if node not in state:
-            visit(node, [node])
+    for node in sorted(graph):
+        if node not in state and (cycle := visit(node, [node])):
+            return cycle
+    return None
+
+
+def test_no_import_cycles():
+    graph = {n: {m for m in deps if m in CORE_MODULES} for n, deps in GRAPH.items()}
+    cycle = find_cycle(graph)
+    assert cycle is None, "import cycle: " + " -> ".join(cycle or [])
+
+
+def test_folders_that_share_a_layer_import_one_another_without_a_cycle():
+    folders: dict[str, set[str]] = {}
+    for name, imported in GRAPH.items():
+        if name not in PUBLIC_FACE:
+            others = {folder_of(m) for m in imported if m in CORE_MODULES} - {folder_of(name)}
+            folders.setdefault(folder_of(name), set()).update(others)
+    cycle = find_cycle(folders)
+    assert cycle is None, "folders import each other: " + " -> ".join(cycle or [])
+
+
+def test_storage_runs_nothing():
+    """Storage sits above run/ only because an archive records and reads back a run's
+    Variant (plug-in names and settings): of run/ it imports that record, never the
+    simulation, and nothing of a layer above."""
+    used = {
+        m
+        for name, imported in GRAPH.items()
+        if name.startswith("plateimpact.storage.")
+        for m in imported
+        if m.startswith("plateimpact.run")
+    }
+    assert used <= {"plateimpact.run.variant"}
 
 
 def test_the_core_never_imports_plug_ins_or_studies_and_plug_ins_use_the_public_api():
@@ -161,9 +197,11 @@ def test_importing_the_package_loads_none_of_its_heavy_dependencies():
     assert run_python(code) == "[]"
 
 
-def test_plotting_leaves_the_users_matplotlib_backend_alone():
+def test_figures_leave_the_users_matplotlib_backend_alone():
+    figures = sorted(p.stem for p in (CORE / "figures").glob("*.py") if p.stem != "__init__")
     code = (
-        "import matplotlib; before = matplotlib.get_backend(); import plateimpact.plotting; "
+        "import importlib, matplotlib; before = matplotlib.get_backend(); "
+        f"[importlib.import_module('plateimpact.figures.' + m) for m in {figures!r}]; "
         "import matplotlib.pyplot as plt; print(before, plt.get_backend())"
     )
     assert run_python(code, MPLBACKEND="svg") == "svg svg"

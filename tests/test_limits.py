@@ -23,7 +23,7 @@ from scipy import integrate
 import plateimpact as pi
 from plateimpact import limits, presets
 from plateimpact.limits import Regime
-from plateimpact.limits.finder import locate, scan_points
+from plateimpact.limits.bracketing import locate, scan_points
 from plateimpact_plugins import CRITICAL_PENETRATION, FAILURE_ANGLE, PlaneSeparation
 
 SPHERE = presets.DEFAULT_SPHERE

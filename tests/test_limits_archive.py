@@ -20,7 +20,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.limits.records import attributes_of
+from plateimpact.limits.archived import attributes_of
 from plateimpact.storage import append as appending
 from plateimpact.storage.lock import locked
 
@@ -297,7 +297,7 @@ def test_a_failure_letting_go_of_the_lock_keeps_the_limits_and_says_so(
     assert limits.stored_limits(path) == ["plugging"]
 
 
-@pytest.mark.filterwarnings("ignore::plateimpact.errors.ArchiveWaitWarning")
+@pytest.mark.filterwarnings("ignore::plateimpact.base.errors.ArchiveWaitWarning")
 def test_limits_that_cannot_wait_for_another_writer_are_saved_aside(tmp_path, plugging):
     path = tmp_path / "a.h5"
     tiny_study().run(archive=path)

@@ -13,7 +13,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.limits import finder
+from plateimpact.limits import bracketing as finder
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/1.27")

@@ -1,4 +1,4 @@
-"""Outcomes and their invariants: the behaviour the report describes (model-notes §8)."""
+"""Outcomes and their invariants: the behaviour the report describes (docs/model.md §8)."""
 
 from __future__ import annotations
 

@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 
 import plateimpact as pi
-from plateimpact.bodies import MASS
 from plateimpact.cli import main
-from plateimpact.scene import IMPACT_OBLIQUITY
-from plateimpact.storage import provenance
+from plateimpact.model.bodies import MASS
+from plateimpact.model.scene import IMPACT_OBLIQUITY
+from plateimpact.provenance import metadata as provenance
 from plateimpact.storage.plate_file import plate_from_dict, plate_to_dict
 
 # -- the source commit ---------------------------------------------------------------

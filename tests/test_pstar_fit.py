@@ -26,9 +26,9 @@ from plateimpact.calibration.outcome_model import (
     allowed_outcomes,
     log_likelihood,
 )
-from plateimpact.calibration.pstar_search import Estimate
+from plateimpact.calibration.pstar_search import PstarEstimate
 from plateimpact.cli import calibrate_pstar, main
-from plateimpact.results import Outcome
+from plateimpact.model.results import Outcome
 from plateimpact.storage import output
 from plateimpact_plugins.variable_pstar import TABLE_COLUMNS, PstarTable
 
@@ -304,7 +304,7 @@ def test_a_full_disk_at_out_keeps_the_old_file(
 ):
     """--out goes through the atomic writer (the fit itself is canned: it is not what
     this test is about)."""
-    estimate = Estimate(3e-3, 3e-5, math.radians(45.0), log_likelihood=-10.0)
+    estimate = PstarEstimate(3e-3, 3e-5, math.radians(45.0), log_likelihood=-10.0)
     model, cost = ProbabilityModel(), Cost()
     plate = presets.plate("2024-T3/3.18")
     fit = pstar.PstarFit(plate, estimate, False, model, 24, 0, "", cost)

@@ -18,7 +18,7 @@ import pytest
 
 import plateimpact as pi
 from plateimpact.cli import main
-from plateimpact.registry import KINDS
+from plateimpact.registry.plugin_registry import KINDS
 from plateimpact_plugins.variable_pstar import SAE1010_TABLE
 
 

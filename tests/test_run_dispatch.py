@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import plateimpact as pi
-from plateimpact import presets, simulation
-from plateimpact.model import ImpactModel
+from plateimpact import presets
+from plateimpact.model.impact import ImpactModel
+from plateimpact.run import simulation
 
 SPEEDS = np.linspace(150.0, 1200.0, 7)
 VARIANTS = [pi.Variant("plugging"), pi.Variant("hinge", failure="hinge")]

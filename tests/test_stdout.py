@@ -24,8 +24,9 @@ DRIVER = textwrap.dedent(
     import io, json, os, sys
     from plateimpact.cli import build_parser, main
     # what the commands import when they need it, imported once before forking
-    import plateimpact.export, plateimpact.limits.figures, plateimpact.plotting
-    import plateimpact.experiment.figure, plateimpact.v50.figure
+    import plateimpact.storage.export, plateimpact.figures.saving
+    import plateimpact.figures.limits_and_maps, plateimpact.figures.validation_panels
+    import plateimpact.figures.v50_fits
     build_parser()
     cases = json.loads(sys.argv[1])
     found = []

@@ -13,12 +13,14 @@ import sys
 from conftest import SCALE, TIME_SCALE
 
 import plateimpact as pi
-from plateimpact import progress
-from plateimpact.storage import archive, provenance
+from plateimpact.provenance import metadata as provenance
+from plateimpact.run import progress
+from plateimpact.storage import archive
 
 SHOW = (
-    "import json, plateimpact as pi; from plateimpact import progress;"
-    "from plateimpact.storage import archive, provenance;"
+    "import json, plateimpact as pi; from plateimpact.run import progress;"
+    "from plateimpact.storage import archive;"
+    "from plateimpact.provenance import metadata as provenance;"
     "print(json.dumps([pi.Archive('a.h5').wait, progress.DELAY, provenance.GIT_TIMEOUT,"
     " pi.MAX_SECONDS.default, pi.Integrator.max_seconds]))"
 )

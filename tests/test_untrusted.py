@@ -1,5 +1,5 @@
 """JSON from someone else within bounds, and file text made inert for a terminal
-(plateimpact.untrusted)."""
+(plateimpact.base.untrusted)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import math
 
 import pytest
 
-from plateimpact.errors import PlateFileError
-from plateimpact.untrusted import MAX_DEPTH, load_json, printable
+from plateimpact.base.errors import PlateFileError
+from plateimpact.base.untrusted import MAX_DEPTH, load_json, printable
 
 
 def test_plain_json_reads_as_json_does():

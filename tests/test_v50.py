@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import optimize, special, stats
 
-from plateimpact.errors import ParameterError, V50Error
+from plateimpact.base.errors import ParameterError, V50Error
 from plateimpact.v50 import fit_v50, mil_std_662f
 
 TRUE_V50, TRUE_SIGMA = 500.0, 20.0  # [m/s]

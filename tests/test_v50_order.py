@@ -16,7 +16,7 @@ import pytest
 import statsmodels.api as sm
 from scipy import stats
 
-from plateimpact.errors import V50Error
+from plateimpact.base.errors import V50Error
 from plateimpact.storage.shots import Shots
 from plateimpact.v50 import METHODS, fit_v50
 from plateimpact.v50 import solver as solver_module

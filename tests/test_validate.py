@@ -194,7 +194,7 @@ def test_a_shots_own_sphere_is_the_one_run_and_searched():
 
 
 def test_the_figure_has_a_panel_per_obliquity_to_the_nearest_degree():
-    from plateimpact.experiment.figure import MAX_PANELS, validation_figure
+    from plateimpact.figures.validation_panels import MAX_PANELS, validation_figure
 
     text = f"{IMPACT},perforated\n200,44.6,0\n300,45.3,1\n250,60,0\n"
     report = pi.validate(SIMULATION, SPHERE, PLATE, pi.Shots.from_csv_text(text))

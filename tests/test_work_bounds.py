@@ -13,8 +13,9 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.errors import WorkBoundError
-from plateimpact.limits import chunked, finder
+from plateimpact.base.errors import WorkBoundError
+from plateimpact.limits import bracketing as finder
+from plateimpact.limits import chunked
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/1.27")

@@ -16,70 +16,70 @@ from typing import TYPE_CHECKING, Any
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
     # the model's data
-    "Sphere": "bodies",
-    "Plate": "bodies",
-    "Scene": "scene",
-    "SceneBatch": "batch",
-    "Parameter": "parameters",
-    "Range": "parameters",
+    "Sphere": "model.bodies",
+    "Plate": "model.bodies",
+    "Scene": "model.scene",
+    "SceneBatch": "model.batch",
+    "Parameter": "base.parameters",
+    "Range": "base.parameters",
     # plug-in interfaces
-    "ResistanceLaw": "resistance",
-    "BoundResistance": "resistance",
-    "contact_force": "resistance",
-    "FailureModel": "failure",
-    "Integrator": "integrator",
-    "Step": "integrator",
-    "StepControl": "integrator",
-    "StepperState": "integrator",
-    "MAX_STEPS": "integrator",
-    "MAX_SECONDS": "integrator",
-    "RTOL": "integrator",
-    "Column": "plugin",
-    "Dynamics": "dynamics",
-    "DenseOutput": "dense",
-    "PolynomialDenseOutput": "dense",
-    "hermite": "dense",
-    "BoundBatch": "binding",
-    "hookimpl": "hookspecs",
-    "PluginRegistry": "registry",
-    "default_registry": "registry",
-    "load_registry": "registry",
-    "BrokenPackage": "discovery",
+    "ResistanceLaw": "model.resistance",
+    "BoundResistance": "model.resistance",
+    "contact_force": "model.resistance",
+    "FailureModel": "model.failure",
+    "Integrator": "solve.integrator",
+    "Step": "solve.integrator",
+    "StepControl": "solve.integrator",
+    "StepperState": "solve.integrator",
+    "MAX_STEPS": "solve.integrator",
+    "MAX_SECONDS": "solve.integrator",
+    "RTOL": "solve.integrator",
+    "Column": "model.plugin",
+    "Dynamics": "solve.dynamics",
+    "DenseOutput": "solve.dense",
+    "PolynomialDenseOutput": "solve.dense",
+    "hermite": "solve.dense",
+    "BoundBatch": "model.binding",
+    "hookimpl": "registry.hookspecs",
+    "PluginRegistry": "registry.plugin_registry",
+    "default_registry": "registry.plugin_registry",
+    "load_registry": "registry.plugin_registry",
+    "BrokenPackage": "registry.discovery",
     # the model and its events
-    "ImpactModel": "model",
-    "KINEMATIC_STATE": "model",
-    "PENETRATION": "model",
-    "LATERAL": "model",
-    "OBLIQUITY": "model",
-    "SPEED": "model",
-    "ONSET": "model",
-    "CONTACT_LOST": "model",
-    "PERFORATED": "model",
-    "AT_REST": "model",
-    "TURNED_BACK": "model",
-    "EVENT_NAMES": "model",
-    "EVENT_OUTCOMES": "model",
-    "contact_geometry": "geometry",
-    "contact_lost_margin": "geometry",
-    "force_inclination": "geometry",
+    "ImpactModel": "model.impact",
+    "KINEMATIC_STATE": "model.impact",
+    "PENETRATION": "model.impact",
+    "LATERAL": "model.impact",
+    "OBLIQUITY": "model.impact",
+    "SPEED": "model.impact",
+    "ONSET": "model.impact",
+    "CONTACT_LOST": "model.impact",
+    "PERFORATED": "model.impact",
+    "AT_REST": "model.impact",
+    "TURNED_BACK": "model.impact",
+    "EVENT_NAMES": "model.impact",
+    "EVENT_OUTCOMES": "model.impact",
+    "contact_geometry": "model.geometry",
+    "contact_lost_margin": "model.geometry",
+    "force_inclination": "model.geometry",
     # running
-    "Simulation": "simulation",
-    "run": "simulation",
-    "Variant": "variant",
-    "Outcome": "results",
-    "Result": "results",
-    "BatchResult": "results",
-    "Trajectory": "results",
-    "CraterSection": "results",
-    "Ragged": "ragged",
+    "Simulation": "run.simulation",
+    "run": "run.simulation",
+    "Variant": "run.variant",
+    "Outcome": "model.results",
+    "Result": "model.results",
+    "BatchResult": "model.results",
+    "Trajectory": "model.results",
+    "CraterSection": "model.results",
+    "Ragged": "model.ragged",
     # storage
     "Archive": "storage.archive",
     "load_plate_file": "storage.plate_file",
     "save_plate_file": "storage.plate_file",
     "Shots": "storage.shots",
-    "synthetic_shots": "storage.synthetic_shots",
-    "synthetic_oblique_shots": "storage.synthetic_shots",
     # analysis
+    "synthetic_shots": "experiment.synthetic_shots",
+    "synthetic_oblique_shots": "experiment.synthetic_shots",
     "Study": "study",
     "StudyResults": "study",
     "Comparison": "comparison",
@@ -103,29 +103,36 @@ _EXPORTS: dict[str, str] = {
     "fit_v50": "v50",
     "mil_std_662f": "v50",
     # errors
-    "PlateImpactError": "errors",
-    "ParameterError": "errors",
-    "UnknownNameError": "errors",
-    "IntegrationError": "errors",
-    "ArchiveError": "errors",
-    "ShotDataError": "errors",
-    "PlateFileError": "errors",
-    "CalibrationError": "errors",
-    "ConvergenceError": "errors",
-    "V50Error": "errors",
-    "PluginError": "errors",
-    "PlateImpactWarning": "errors",
-    "ArchiveWaitWarning": "errors",
-    "PluginLoadWarning": "errors",
+    "PlateImpactError": "base.errors",
+    "ParameterError": "base.errors",
+    "UnknownNameError": "base.errors",
+    "IntegrationError": "base.errors",
+    "ArchiveError": "base.errors",
+    "ShotDataError": "base.errors",
+    "PlateFileError": "base.errors",
+    "CalibrationError": "base.errors",
+    "ConvergenceError": "base.errors",
+    "V50Error": "base.errors",
+    "PluginError": "base.errors",
+    "PlateImpactWarning": "base.errors",
+    "ArchiveWaitWarning": "base.errors",
+    "PluginLoadWarning": "base.errors",
     # files from someone else (a plug-in that reads a file a user names checks it first)
-    "check_input": "untrusted",
-    "load_json": "untrusted",
-    "printable": "untrusted",
+    "check_input": "base.untrusted",
+    "load_json": "base.untrusted",
+    "printable": "base.untrusted",
 }
-#: Submodules users reach as attributes (``pi.units.mm``).
-_SUBMODULES = (
-    "batch", "calibration", "experiment", "geometry", "limits", "presets", "units", "v50",
-)  # fmt: skip
+#: Submodules users reach as attributes (``pi.units.mm``) -> where each is.
+_SUBMODULES: dict[str, str] = {
+    "batch": "model.batch",
+    "calibration": "calibration",
+    "experiment": "experiment",
+    "geometry": "model.geometry",
+    "limits": "limits",
+    "presets": "model.presets",
+    "units": "units",
+    "v50": "v50",
+}
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
@@ -134,7 +141,7 @@ def __getattr__(name: str) -> Any:
     if name in _EXPORTS:
         value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
     elif name in _SUBMODULES:
-        value = importlib.import_module(f".{name}", __name__)
+        value = importlib.import_module(f".{_SUBMODULES[name]}", __name__)
     elif name == "__version__":
         from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
 
@@ -153,9 +160,25 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
-    from . import batch, calibration, experiment, geometry, presets, units, v50
-    from .binding import BoundBatch
-    from .bodies import Plate, Sphere
+    from . import calibration, experiment, units, v50
+    from .base.errors import (
+        ArchiveError,
+        ArchiveWaitWarning,
+        CalibrationError,
+        ConvergenceError,
+        IntegrationError,
+        ParameterError,
+        PlateFileError,
+        PlateImpactError,
+        PlateImpactWarning,
+        PluginError,
+        PluginLoadWarning,
+        ShotDataError,
+        UnknownNameError,
+        V50Error,
+    )
+    from .base.parameters import Parameter, Range
+    from .base.untrusted import check_input, load_json, printable
     from .calibration import (
         Calibration,
         CalibrationReport,
@@ -172,39 +195,14 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         newton_fit,
     )
     from .comparison import Comparison
-    from .dense import DenseOutput, PolynomialDenseOutput, hermite
-    from .discovery import BrokenPackage
-    from .dynamics import Dynamics
-    from .errors import (
-        ArchiveError,
-        ArchiveWaitWarning,
-        CalibrationError,
-        ConvergenceError,
-        IntegrationError,
-        ParameterError,
-        PlateFileError,
-        PlateImpactError,
-        PlateImpactWarning,
-        PluginError,
-        PluginLoadWarning,
-        ShotDataError,
-        UnknownNameError,
-        V50Error,
-    )
     from .experiment import ValidationReport, validate
-    from .failure import FailureModel
-    from .geometry import contact_geometry, contact_lost_margin, force_inclination
-    from .hookspecs import hookimpl
-    from .integrator import (
-        MAX_SECONDS,
-        MAX_STEPS,
-        RTOL,
-        Integrator,
-        Step,
-        StepControl,
-        StepperState,
-    )
-    from .model import (
+    from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots
+    from .model import batch, geometry, presets
+    from .model.binding import BoundBatch
+    from .model.bodies import Plate, Sphere
+    from .model.failure import FailureModel
+    from .model.geometry import contact_geometry, contact_lost_margin, force_inclination
+    from .model.impact import (
         AT_REST,
         CONTACT_LOST,
         EVENT_NAMES,
@@ -219,21 +217,31 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         TURNED_BACK,
         ImpactModel,
     )
-    from .parameters import Parameter, Range
-    from .plugin import Column
-    from .ragged import Ragged
-    from .registry import PluginRegistry, default_registry, load_registry
-    from .resistance import BoundResistance, ResistanceLaw, contact_force
-    from .results import BatchResult, CraterSection, Outcome, Result, Trajectory
-    from .scene import Scene
-    from .simulation import Simulation, run
+    from .model.plugin import Column
+    from .model.ragged import Ragged
+    from .model.resistance import BoundResistance, ResistanceLaw, contact_force
+    from .model.results import BatchResult, CraterSection, Outcome, Result, Trajectory
+    from .model.scene import Scene
+    from .registry.discovery import BrokenPackage
+    from .registry.hookspecs import hookimpl
+    from .registry.plugin_registry import PluginRegistry, default_registry, load_registry
+    from .run.simulation import Simulation, run
+    from .run.variant import Variant
+    from .solve.dense import DenseOutput, PolynomialDenseOutput, hermite
+    from .solve.dynamics import Dynamics
+    from .solve.integrator import (
+        MAX_SECONDS,
+        MAX_STEPS,
+        RTOL,
+        Integrator,
+        Step,
+        StepControl,
+        StepperState,
+    )
     from .storage.archive import Archive
     from .storage.plate_file import load_plate_file, save_plate_file
     from .storage.shots import Shots
-    from .storage.synthetic_shots import synthetic_oblique_shots, synthetic_shots
     from .study import Study, StudyResults
-    from .untrusted import check_input, load_json, printable
     from .v50 import MilStd662F, V50Fit, fit_v50, mil_std_662f
-    from .variant import Variant
 
     __version__: str

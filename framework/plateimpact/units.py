@@ -1,19 +1,8 @@
-"""Unit factors between the user's edge and the SI units used inside.
-
-Inside plateimpact everything is SI (m, kg, s, N, rad). Users speak mm, m/s, g and
-degrees; multiply by these factors on the way in and divide on the way out::
-
-    from plateimpact.units import mm, deg
-    Sphere.of_density(radius=3.175 * mm, density=7830.0)
-"""
+"""``plateimpact.units``, the path the README and scripts import unit factors from
+(``from plateimpact.units import mm, deg``): the factors of :mod:`plateimpact.base.units`."""
 
 from __future__ import annotations
 
-import math
+from .base.units import deg, g, mm
 
-mm = 1.0e-3
-"""One millimetre [m]."""
-g = 1.0e-3
-"""One gram [kg]."""
-deg = math.pi / 180.0
-"""One degree [rad]."""
+__all__ = ["deg", "g", "mm"]

@@ -55,7 +55,8 @@ class Hinge(PlaneSeparation):
 
     F″ acts at ψ″ = 90° + θ − θ1 − β/2 from the path while θ < θ1 and 90° − β/2 after
     (eqs 19–20), on the same side as F*: its drag resists the motion and its lift turns
-    the sphere outward. θ1 = 90° − α* (model-notes §5; docs/hinge.md gives the reasons).
+    the sphere outward. θ1 = 90° − α* (docs/hinge.md, "Readings we took", 1, gives the
+    reasons).
 
     Parameters
     ----------

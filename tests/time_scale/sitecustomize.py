@@ -49,9 +49,9 @@ def _integrator(module: ModuleType, scale: float) -> None:
 #: What to scale in each module, once it is loaded.
 LIMITS: dict[str, Callable[[ModuleType, float], None]] = {
     "plateimpact.storage.archive": _archive,
-    "plateimpact.progress": _progress,
-    "plateimpact.storage.provenance": _provenance,
-    "plateimpact.integrator": _integrator,
+    "plateimpact.run.progress": _progress,
+    "plateimpact.provenance.metadata": _provenance,
+    "plateimpact.solve.integrator": _integrator,
 }
 
 

@@ -7,7 +7,7 @@ import math
 import attrs
 import numpy as np
 
-from ..errors import CalibrationError
+from ..base.errors import CalibrationError
 
 #: Fewest perforating shots a DRI fit takes: two fix R and V0, a third leaves a residual.
 MIN_PERFORATIONS = 3

@@ -9,10 +9,10 @@ import attrs
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ConvergenceError, WorkBoundError
-from ..presets import DEFAULT_SPHERE
-from ..simulation import Simulation
+from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
+from ..model.bodies import Plate, Sphere
+from ..model.presets import DEFAULT_SPHERE
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
 from .pstar_plan import MAX_FIT_SCENES
@@ -339,7 +339,7 @@ def calibrate(
     max_scenes: int | None = MAX_FIT_SCENES,
 ) -> CalibrationReport:
     """The DRI fit of ``shots`` and a, b by both methods (``plate``: T, P*, α*).
-    :class:`~plateimpact.errors.WorkBoundError` before any scene runs if the fits could
+    :class:`~plateimpact.base.errors.WorkBoundError` before any scene runs if the fits could
     run more than ``max_scenes`` scenes (AB_SCENES_PER_SHOT per normal-incidence shot;
     None: no bound)."""
     simulation = simulation or Simulation.from_names()

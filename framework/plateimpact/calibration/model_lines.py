@@ -15,19 +15,19 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
-from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from ..limits import locate, regime_codes
+from ..limits.bracketing import RELATIVE_FLOOR
 from ..limits.chunked import run_chunked
-from ..limits.finder import RELATIVE_FLOOR
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
-from ..simulation import Simulation
+from ..model.batch import SceneBatch
+from ..model.bodies import Plate, Sphere
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
+from ..run.simulation import Simulation
 from .outcome_model import Bands, ShotLines
 
 #: The finder's tolerance [m/s]: from RELATIVE_FLOOR of the fastest speed a line can
-#: reach (what a double resolves there: limits.finder) to 10 m/s; its resolution [m/s]
+#: reach (what a double resolves there: limits.bracketing) to 10 m/s; its resolution [m/s]
 #: from the tolerance to 100 m/s.
 TOLERANCE_RANGE = (RELATIVE_FLOOR * IMPACT_SPEED.range.high, 10.0)
 MAX_RESOLUTION = 100.0

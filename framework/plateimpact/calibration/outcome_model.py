@@ -26,9 +26,9 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.special import ndtr, ndtri
 
-from ..errors import ParameterError
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
+from ..base.errors import ParameterError
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
 
 #: The speed scatter s [m/s] unless given: about 2-3 % of the report's ballistic limits.
 SPEED_SIGMA = 10.0

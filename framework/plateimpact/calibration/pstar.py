@@ -13,16 +13,16 @@ import math
 import attrs
 import numpy as np
 
-from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ConvergenceError
+from ..base.errors import CalibrationError, ConvergenceError
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
-from ..presets import DEFAULT_SPHERE
-from ..simulation import Simulation
+from ..model.bodies import Plate, Sphere
+from ..model.presets import DEFAULT_SPHERE
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .model_lines import Cost, LineModel, check_finder
 from .outcome_model import ProbabilityModel, ShotLines, allowed_outcomes, shot_lines
 from .pstar_plan import MAX_FIT_SCENES, check_work, unfittable
-from .pstar_search import ALPHA, PSTAR, Estimate, Search, fit_sets, fit_with_alpha
+from .pstar_search import ALPHA, PSTAR, PstarEstimate, Search, fit_sets, fit_with_alpha
 
 #: Fewest shots for a fit of P*, and for each range of the by-obliquity fit.
 MIN_SHOTS = 5
@@ -47,7 +47,7 @@ STDERR_COLUMNS = ("ricochet_pstar_stderr_mm", "perforation_pstar_stderr_mm")
 
 
 @attrs.frozen(eq=False)
-class Prepared:
+class PreparedShots:
     """A shot set ready for a likelihood: its lines (None if no shot is usable), how many
     shots and residual speeds it uses, and a note on residual speeds left out."""
 
@@ -57,7 +57,7 @@ class Prepared:
     note: str = ""
 
 
-def prepare(shots: Shots, sphere: Sphere, question: str, model: ProbabilityModel) -> Prepared:
+def prepare(shots: Shots, sphere: Sphere, question: str, model: ProbabilityModel) -> PreparedShots:
     """The shots that say something about ``question`` (outcome_model.QUESTIONS), with
     weight > 0, on their lines; residual speeds of perforations for ``outcome`` and
     ``perforation``, unless fewer than MIN_RESIDUALS and σ_r is to be fitted."""
@@ -76,13 +76,13 @@ def prepare(shots: Shots, sphere: Sphere, question: str, model: ProbabilityModel
         )
         recorded[:] = False
     if not use.any():
-        return Prepared(None, 0, 0, note)
+        return PreparedShots(None, 0, 0, note)
     lines = shot_lines(
         shots.impact_speed[use], shots.impact_obliquity[use], radius[use], mass[use],
         allowed[use], np.where(recorded, residual, np.nan)[use], shots.weight[use],
         model.speed_sigma,
     )  # fmt: skip
-    return Prepared(lines, int(use.sum()), int(recorded.sum()), note)
+    return PreparedShots(lines, int(use.sum()), int(recorded.sum()), note)
 
 
 def _check_model(simulation: Simulation, fit_alpha: bool) -> None:
@@ -103,7 +103,7 @@ class PstarFit:
     the standard errors, log-likelihood, σ_r and the model's bands at the maximum."""
 
     plate: Plate
-    estimate: Estimate
+    estimate: PstarEstimate
     alpha_fitted: bool
     model: ProbabilityModel
     shots: int
@@ -140,7 +140,7 @@ def fit_pstar(
     ``plate`` gives a, b and α* (the start when fitted); ``resolution`` and
     ``tolerance`` [m/s] are the boundary finder's. Before any scene runs:
     :class:`CalibrationError` when the shots are too few or plainly cannot fix P*
-    (:func:`~.pstar_plan.unfittable`), :class:`~plateimpact.errors.WorkBoundError` when
+    (:func:`~.pstar_plan.unfittable`), :class:`~plateimpact.base.errors.WorkBoundError` when
     the fit would run more than about ``max_scenes`` scenes (None: no bound). After:
     :class:`CalibrationError` when the likelihood does not fix P*,
     :class:`ConvergenceError` when the search does not converge.
@@ -187,8 +187,8 @@ class PstarRow:
     the shots each used, the transition band [m/s] of the table, and notes."""
 
     obliquity: float
-    ricochet: Estimate
-    perforation: Estimate
+    ricochet: PstarEstimate
+    perforation: PstarEstimate
     ricochet_shots: int
     perforation_shots: int
     transition_start: float
@@ -244,7 +244,7 @@ def fit_pstar_by_obliquity(
     before any scene runs: those where neither range can fix P* (too few shots, or all
     one outcome: :func:`~.pstar_plan.unfittable`) raise one :class:`CalibrationError`
     naming the first and counting the rest, and a fit over about ``max_scenes`` scenes a
-    :class:`~plateimpact.errors.WorkBoundError`; an obliquity whose likelihoods turn out
+    :class:`~plateimpact.base.errors.WorkBoundError`; an obliquity whose likelihoods turn out
     to fix neither raises :class:`CalibrationError` after the fit, all of them at once."""
     simulation = simulation or Simulation.from_names()
     model = model or ProbabilityModel()
@@ -260,8 +260,8 @@ def fit_pstar_by_obliquity(
             "obliquity: round measured obliquities to the nominal ones first)"
         )
     groups = shots.groups_by_obliquity()
-    parts: dict[tuple[float, str], Prepared] = {}
-    fitted: dict[tuple[float, str], Estimate] = {}
+    parts: dict[tuple[float, str], PreparedShots] = {}
+    fitted: dict[tuple[float, str], PstarEstimate] = {}
     sets, keys, refused = [], [], []
     for obliquity, group in groups.items():
         reasons = []
@@ -274,7 +274,7 @@ def fit_pstar_by_obliquity(
                 keys.append((obliquity, question))
             else:
                 reasons.append(f"{question} range: {reason}")
-                fitted[obliquity, question] = Estimate(
+                fitted[obliquity, question] = PstarEstimate(
                     math.nan, math.nan, plate.failure_angle, identified=False, reason=str(reason)
                 )
         if len(reasons) == 2:
@@ -317,8 +317,8 @@ def _refuse(refused: list[tuple[float, str]], when: str) -> None:
 def _row(
     obliquity: float,
     group: Shots,
-    parts: dict[tuple[float, str], Prepared],
-    fitted: dict[tuple[float, str], Estimate],
+    parts: dict[tuple[float, str], PreparedShots],
+    fitted: dict[tuple[float, str], PstarEstimate],
 ) -> PstarRow:
     ricochet, perforation = fitted[obliquity, "ricochet"], fitted[obliquity, "perforation"]
     if not (ricochet.identified or perforation.identified):
@@ -343,7 +343,7 @@ def _row(
 
 
 def _transition(
-    group: Shots, ricochet: Estimate, perforation: Estimate
+    group: Shots, ricochet: PstarEstimate, perforation: PstarEstimate
 ) -> tuple[float, float, str]:
     """The table's band [m/s]: from the last ricochet with the ricochet-range P* to the
     first perforation with the perforation-range P* (docs/variable-pstar.md), on the

@@ -20,8 +20,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import WorkBoundError
-from ..results import Outcome
+from ..base.errors import WorkBoundError
+from ..model.results import Outcome
 from .outcome_model import ShotLines
 from .pstar_search import ALPHA_FIT_EVALUATIONS, SCAN_POINTS, scan_scenes
 

@@ -26,8 +26,8 @@ import attrs
 import numpy as np
 from scipy.optimize import elementwise, minimize
 
-from ..errors import ConvergenceError
-from ..limits.finder import GROUP_SCENES, scan_intervals
+from ..base.errors import ConvergenceError
+from ..limits.bracketing import GROUP_SCENES, scan_intervals
 from .model_lines import Cost, LineModel
 from .outcome_model import Bands, ProbabilityModel, ShotLines, log_likelihood
 
@@ -69,7 +69,7 @@ def scan_scenes(shots: ShotLines, resolution: float) -> int:
 
 
 @attrs.frozen
-class Estimate:
+class PstarEstimate:
     """What one shot set says: P* [m] and its standard error, α* [rad] (its standard
     error NaN unless fitted), their correlation, the log-likelihood at the maximum, σ_r
     [m/s] (NaN without residual speeds), the model's ``bands`` on each line there, and
@@ -164,14 +164,14 @@ class Search:
         return count
 
 
-def fit_sets(search: Search) -> list[Estimate]:
+def fit_sets(search: Search) -> list[PstarEstimate]:
     """P* of every shot set of ``search`` at the plate's α* (see the module's steps);
     a set that does not fix P* gets an unidentified estimate saying why."""
     n = len(search.sets)
     grid = np.linspace(math.log(PSTAR_RANGE[0]), math.log(PSTAR_RANGE[1]), SCAN_POINTS)
     index = np.repeat(np.arange(n), SCAN_POINTS)
     scan = -search.value(np.tile(grid, n), index).reshape(n, SCAN_POINTS)
-    out: list[Estimate | None] = [None] * n
+    out: list[PstarEstimate | None] = [None] * n
     bracketed = []
     for k in range(n):
         best = int(np.argmax(scan[k]))
@@ -218,7 +218,7 @@ def fit_sets(search: Search) -> list[Estimate]:
             if not information > 0.0:
                 out[k] = _unidentified(search, "the likelihood is not peaked at its maximum")
                 continue
-            out[k] = Estimate(
+            out[k] = PstarEstimate(
                 pstar=pstar,
                 pstar_stderr=pstar / math.sqrt(information),
                 alpha=search.alpha,
@@ -278,7 +278,7 @@ def _principal_information(
     return information, basis, values
 
 
-def fit_with_alpha(search: Search, start: Estimate) -> tuple[Estimate, bool]:
+def fit_with_alpha(search: Search, start: PstarEstimate) -> tuple[PstarEstimate, bool]:
     """P* and α* of shot set 0 by Nelder–Mead from ``start`` (P* at the plate's α*), in
     coordinates whitened by the information matrix there (unit steps are one standard
     error along each principal direction, so the oblique ridge is round); returns the
@@ -317,7 +317,7 @@ def fit_with_alpha(search: Search, start: Estimate) -> tuple[Estimate, bool]:
     x, alpha = (float(v) for v in best)
     pstar = search.radius * math.exp(x)
     centre_value, sigma, bands = values[4]
-    estimate = Estimate(
+    estimate = PstarEstimate(
         pstar=pstar,
         pstar_stderr=pstar * math.sqrt(cov[0, 0]),
         alpha=alpha,
@@ -331,8 +331,8 @@ def fit_with_alpha(search: Search, start: Estimate) -> tuple[Estimate, bool]:
     return estimate, bool(result.success) and _inside(best)
 
 
-def _unidentified(search: Search, reason: str) -> Estimate:
-    return Estimate(math.nan, math.nan, search.alpha, identified=False, reason=reason)
+def _unidentified(search: Search, reason: str) -> PstarEstimate:
+    return PstarEstimate(math.nan, math.nan, search.alpha, identified=False, reason=reason)
 
 
 def _range_mm(search: Search) -> str:

@@ -9,14 +9,14 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.integrate import quad
 
-from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
-from ..errors import CalibrationError, ShotDataError
-from ..geometry import contact_geometry
+from ..base.errors import CalibrationError, ShotDataError
+from ..base.parameters import Range
 from ..limits.chunked import run_chunked
-from ..parameters import Range
-from ..results import Outcome
-from ..simulation import Simulation
+from ..model.batch import SceneBatch
+from ..model.bodies import Plate, Sphere
+from ..model.geometry import contact_geometry
+from ..model.results import Outcome
+from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
 

@@ -14,10 +14,10 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from ..errors import ParameterError, PlateImpactError, PluginError
-from ..registry import KINDS, PluginRegistry, default_registry
-from ..storage.provenance import versions
-from ..untrusted import printable
+from ..base.errors import ParameterError, PlateImpactError, PluginError
+from ..base.untrusted import printable
+from ..provenance.metadata import versions
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from . import (
     archive_commands,
     calibrate,

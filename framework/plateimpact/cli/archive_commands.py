@@ -9,20 +9,20 @@ from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any
 
-from ..discovery import (
+from ..base.errors import ArchiveError, PluginError
+from ..base.untrusted import printable
+from ..registry.discovery import (
     BrokenPackage,
     distribution_label,
     entry_point_label,
     first_line,
     installed_entry_points,
 )
-from ..errors import ArchiveError, PluginError
-from ..progress import progress_bar
+from ..run.progress import progress_bar
 from ..storage.append import RunExistsError
 from ..storage.archive import Archive
 from ..storage.confined import check_lengths
-from ..study import Study, StudyResults
-from ..untrusted import printable
+from ..study.study import Study, StudyResults
 from .common import UsageError, add_dpi_option, check_directory, output_directory, say
 from .describe import run_description
 from .run_comparison import print_comparison
@@ -164,7 +164,7 @@ REPRODUCE_SPARE = 128
 
 
 def reproduce_command(args: argparse.Namespace) -> None:
-    from ..storage.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
+    from ..study.reruns import StaleRunError  # noqa: PLC0415 (hashing only when asked)
 
     reproduce = study_collection("report")
     if args.out is None:  # a quick archive holds other scenes: never the full one's place
@@ -268,17 +268,18 @@ def compare_command(args: argparse.Namespace) -> None:
     comparison = results.compare(archive.resolve(args.run_a), archive.resolve(args.run_b))
     print_comparison(comparison, as_json=args.json, summary=args.summary)
     if args.png:
-        from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
-        from ..comparison.figure import plot_comparison  # noqa: PLC0415
+        from ..figures import saving  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.compared_runs import plot_comparison  # noqa: PLC0415
 
-        plotting.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
+        saving.save(plot_comparison(comparison), args.png, "--png", dpi=args.dpi)
         if not args.json:
             say(f"figure: {args.png}")
 
 
 def plot_command(args: argparse.Namespace) -> None:
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
-    from ..path_figures import plot_study_paths  # noqa: PLC0415
+    from ..figures import saving  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.exit_curves import plot_study  # noqa: PLC0415
+    from ..figures.study_paths import plot_study_paths  # noqa: PLC0415
 
     check_directory(args.out, "--out", "figure")
     for speed in args.speed or ():
@@ -288,13 +289,13 @@ def plot_command(args: argparse.Namespace) -> None:
         results = _study_results(Archive(args.archive), args.run)
         stages.update()
         if args.kind == "exit":
-            figure = plotting.plot_study(results)
+            figure = plot_study(results)
         else:
             try:
                 figure = plot_study_paths(results, kind=args.kind, speeds=args.speed)
             except ValueError as exc:
                 raise UsageError(str(exc)) from None
         stages.update()
-        plotting.save(figure, args.out, "--out", dpi=args.dpi)
+        saving.save(figure, args.out, "--out", dpi=args.dpi)
         stages.update()
     say(f"figure: {args.out}")

@@ -11,17 +11,17 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..bodies import Plate, Sphere
+from ..base.units import g, mm
 from ..calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
 from ..calibration.pstar_plan import MAX_FIT_SCENES
-from ..progress import reporting_scenes
-from ..registry import PluginRegistry
-from ..simulation import Simulation
+from ..model.bodies import Plate, Sphere
+from ..provenance.metadata import versions
+from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
+from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
-from ..storage.provenance import versions
 from ..storage.shots import Shots
 from ..storage.together import write_together
-from ..units import g, mm
 from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
 from .common import (
     add_dpi_option,
@@ -235,7 +235,8 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
 
 def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
     """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.calibration_fit import plot_calibration  # noqa: PLC0415 (matplotlib only when drawing)
+    from ..figures.style import figure  # noqa: PLC0415
 
     normal = report.shots.normal_incidence()
     speeds = np.linspace(
@@ -245,8 +246,8 @@ def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -
     curves = model_residual_speeds(
         simulation, sphere, fits[0].plate, speeds, [(f.a, f.b) for f in fits]
     )
-    fig, ax = plotting.figure(figsize=(7, 5))
-    plotting.plot_calibration(
+    fig, ax = figure(figsize=(7, 5))
+    plot_calibration(
         ax,
         normal,
         report.dri,

@@ -9,7 +9,7 @@ import math
 import os
 from typing import Any
 
-from ..bodies import Plate, Sphere
+from ..base.units import g, mm
 from ..calibration.model_lines import Cost, check_finder
 from ..calibration.outcome_model import (
     OUTCOME_BLUNDER,
@@ -24,14 +24,14 @@ from ..calibration.pstar import (
     fit_pstar_by_obliquity,
 )
 from ..calibration.pstar_plan import MAX_FIT_SCENES
-from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, Estimate
+from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, PstarEstimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
-from ..progress import reporting_scenes
-from ..simulation import Simulation
+from ..model.bodies import Plate, Sphere
+from ..provenance.metadata import versions
+from ..run.progress import reporting_scenes
+from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
-from ..storage.provenance import versions
 from ..storage.shots import Shots
-from ..units import g, mm
 from .common import UsageError, check_directory, say, write_atomically
 from .options import bodies, model_choice, typed
 
@@ -279,7 +279,7 @@ def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
     return "\n".join(lines)
 
 
-def _estimate_json(prefix: str, e: Estimate, shots: int) -> dict[str, Any]:
+def _estimate_json(prefix: str, e: PstarEstimate, shots: int) -> dict[str, Any]:
     return {
         f"{prefix}_pstar_mm": e.pstar / mm,
         f"{prefix}_pstar_mm_stderr": _finite(e.pstar_stderr / mm),
@@ -323,7 +323,7 @@ def _table_summary(
 
 
 def _table_text(args: argparse.Namespace, table: PstarTableFit) -> str:
-    def value(e: Estimate) -> str:
+    def value(e: PstarEstimate) -> str:
         if not e.identified:
             return f"{e.pstar / mm:.4g} (not fitted)"
         return f"{e.pstar / mm:.4g} ± {e.pstar_stderr / mm:.2g}"

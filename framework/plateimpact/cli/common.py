@@ -16,7 +16,8 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
-from ..errors import PlateImpactError
+from ..base.errors import PlateImpactError
+from ..base.untrusted import printable, spreadsheet_safe
 from ..storage.output import (
     FIGURE_DPI,
     FIGURE_DPI_RANGE,
@@ -28,7 +29,6 @@ from ..storage.output import (
     write_text,
 )
 from ..storage.together import Output
-from ..untrusted import printable, spreadsheet_safe
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -119,10 +119,10 @@ def save_figure_atomically(
     fig: Figure, path: str, flag: str = "--png", dpi: float | None = None
 ) -> None:
     """Save a figure to ``path`` (format from its extension), all of it or nothing;
-    ``dpi`` [dots per inch] for a raster (default: plotting's)."""
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    ``dpi`` [dots per inch] for a raster (default: figures.saving's)."""
+    from ..figures import saving  # noqa: PLC0415 (matplotlib only when drawing)
 
-    plotting.save(fig, path, flag, dpi=plotting.DPI if dpi is None else dpi)
+    saving.save(fig, path, flag, dpi=saving.DPI if dpi is None else dpi)
 
 
 def text_output(path: str, text: str, flag: str, kind: str = "csv") -> Output:
@@ -132,10 +132,10 @@ def text_output(path: str, text: str, flag: str, kind: str = "csv") -> Output:
 
 def figure_output(fig: Figure, path: str, flag: str, dpi: float | None = None) -> Output:
     """A figure to ``path`` (format from its extension; ``dpi`` [dots per inch] for a
-    raster, default plotting's): one file of a set written together."""
-    from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+    raster, default figures.saving's): one file of a set written together."""
+    from ..figures import saving  # noqa: PLC0415 (matplotlib only when drawing)
 
-    writer = plotting.figure_writer(fig, path, plotting.DPI if dpi is None else dpi)
+    writer = saving.figure_writer(fig, path, saving.DPI if dpi is None else dpi)
     return Output(path, flag, writer, "figure")
 
 

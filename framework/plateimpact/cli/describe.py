@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
-from ..batch import CORE_COLUMNS, SceneBatch
-from ..parameters import Parameter
-from ..registry import KINDS, default_registry
-from ..results import BatchResult
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
+from ..model.batch import CORE_COLUMNS, SceneBatch
+from ..model.results import BatchResult
+from ..registry.plugin_registry import KINDS, default_registry
 from ..storage.archive import Archive
-from ..untrusted import printable
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.
 LISTED_VALUES = 6
@@ -102,7 +102,7 @@ def run_description(archive: Archive, name: str) -> list[str]:
     meta: dict[str, Any] = archive.metadata(name)
     result: BatchResult = archive.results(name)
     counts = np.bincount(result.outcome, minlength=4)[1:]
-    from ..storage.code_provenance import summary  # noqa: PLC0415 (hashing only here)
+    from ..provenance.code import summary  # noqa: PLC0415 (hashing only here)
 
     lines = [shown(name, None), *run_lines(meta)]
     # each plug-in's origin and source hash (printable already)

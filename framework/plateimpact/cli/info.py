@@ -8,10 +8,10 @@ import inspect
 import json
 from typing import Any
 
-from .. import presets
-from ..bodies import MASS, RADIUS, THICKNESS
-from ..parameters import Parameter
-from ..registry import KINDS, PluginRegistry, default_registry
+from ..base.parameters import Parameter
+from ..model import presets
+from ..model.bodies import MASS, RADIUS, THICKNESS
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from .common import say
 from .describe import shown
 

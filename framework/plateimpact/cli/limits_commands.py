@@ -12,10 +12,10 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
-from ..errors import ArchiveError
-from ..progress import reporting_scenes
-from ..registry import PluginRegistry
-from ..results import Outcome
+from ..base.errors import ArchiveError
+from ..model.results import Outcome
+from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
 from ..storage.archive import Archive
 from ..storage.together import write_together
 from .common import (
@@ -230,7 +230,7 @@ def limits_command(args: argparse.Namespace) -> None:
     if args.csv is not None:
         outputs.append(text_output(args.csv, _csv(found), "--csv"))
     if args.png is not None:
-        from ..limits.figures import plot_bands  # noqa: PLC0415 (matplotlib when drawing)
+        from ..figures.limits_and_maps import plot_bands  # noqa: PLC0415 (matplotlib when drawing)
 
         outputs.append(figure_output(plot_bands(found, label), args.png, "--png", args.dpi))
     write_together(outputs)
@@ -320,7 +320,7 @@ def map_command(args: argparse.Namespace) -> None:
         f"{', '.join(shown(label, None) for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
         f"{shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
     )
-    from ..limits.figures import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
+    from ..figures.limits_and_maps import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
     draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves
     save_figure_atomically(draw(maps), args.png, dpi=args.dpi)

@@ -16,15 +16,15 @@ from typing import Any
 
 import attrs
 
-from .. import presets
-from ..bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..model import REST_SPEED_FRACTION, ImpactModel
-from ..parameters import Parameter, json_literal
-from ..registry import KINDS, PluginRegistry, default_registry
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from ..base.parameters import Parameter, json_literal
+from ..base.untrusted import load_json
+from ..model import presets
+from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from ..model.impact import REST_SPEED_FRACTION, ImpactModel
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
+from ..run.simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
 from ..storage.plate_file import load_plate_file
-from ..untrusted import load_json
 from .common import UsageError
 
 #: The model slots ``--set`` knows besides the plug-in kinds.

@@ -18,10 +18,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol, TextIO
 
-from ..discovery import first_line
-from ..errors import PlateImpactWarning
-from ..storage.provenance import versions
-from ..untrusted import printable
+from ..base.errors import PlateImpactWarning
+from ..base.untrusted import printable
+from ..provenance.metadata import versions
+from ..registry.discovery import first_line
 
 
 class ShowWarning(Protocol):

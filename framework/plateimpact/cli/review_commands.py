@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from ..storage.archive import Archive
 from ..storage.output import write_output
 from .common import UsageError, check_directory, csv_text, say
@@ -41,7 +41,7 @@ def upgrade_command(args: argparse.Namespace) -> None:
 
 
 def export_command(args: argparse.Namespace) -> None:
-    from .. import export  # noqa: PLC0415 (netCDF and table writing only here)
+    from ..storage import export  # noqa: PLC0415 (netCDF and table writing only here)
 
     try:
         kind = export.export_path_kind(args.to)

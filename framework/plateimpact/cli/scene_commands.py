@@ -8,16 +8,16 @@ from typing import Any
 
 import numpy as np
 
-from ..bodies import Plate, Sphere
-from ..crater import crater_section
-from ..parameters import Parameter
-from ..progress import reporting_scenes
-from ..registry import PluginRegistry, default_registry
-from ..results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
-from ..simulation import Simulation
-from ..storage.inputs import load_run_inputs
-from ..storage.provenance import inputs_record
+from ..base.parameters import Parameter
+from ..model.bodies import Plate, Sphere
+from ..model.crater import crater_section
+from ..model.results import CRATER_FIELDS, TRAJECTORY_FIELDS, Outcome
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
+from ..provenance.inputs import load_run_inputs
+from ..provenance.metadata import inputs_record
+from ..registry.plugin_registry import PluginRegistry, default_registry
+from ..run.progress import reporting_scenes
+from ..run.simulation import Simulation
 from ..storage.together import write_together
 from .common import (
     UsageError,
@@ -208,10 +208,11 @@ def crater_command(args: argparse.Namespace) -> None:
         rows = zip(section.lateral / lateral.scale, section.depth / depth.scale, strict=True)
         outputs.append(text_output(args.csv, csv_text([lateral.key, depth.key], rows), "--csv"))
     if args.png is not None:
-        from .. import plotting  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.crater_sections import plot_crater  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.style import figure  # noqa: PLC0415
 
-        fig, ax = plotting.figure(figsize=(8, 4))
-        plotting.plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
+        fig, ax = figure(figsize=(8, 4))
+        plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
         speed, obliquity = float(args.speed), float(args.obliquity)
         ax.set_title(f"{label}, {speed:g} m/s at {obliquity:g}°: {result.outcome.label}")
         outputs.append(figure_output(fig, args.png, "--png", args.dpi))
@@ -247,7 +248,7 @@ def _parse_obliquities(text: str) -> np.ndarray:
 def sweep_inputs(
     args: argparse.Namespace, simulation: Simulation, sphere: Sphere, plate: Plate, label: str
 ) -> dict[str, Any]:
-    """The inputs record of a sweep (storage.provenance), for the sidecar of its --csv."""
+    """The inputs record of a sweep (provenance.metadata), for the sidecar of its --csv."""
     return inputs_record(
         simulation,
         sphere,

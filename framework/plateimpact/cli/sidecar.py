@@ -14,9 +14,9 @@ import os
 from collections.abc import Iterable, Mapping
 from typing import IO, Any
 
+from ..base.untrusted import load_json_file
 from ..storage.output import streamed
 from ..storage.together import Output
-from ..untrusted import load_json_file
 from .common import UsageError
 
 #: The key of the sidecar that holds the CSV's SHA-256 [hex].

@@ -5,13 +5,13 @@ from __future__ import annotations
 import json
 import math
 
-from ..errors import UnknownNameError
+from ..base.errors import UnknownNameError
 from ..limits import LimitsComparison, OutcomeMap, compare_limits, read_limits
+from ..limits.archived import KIND_MAP, NAMES, attributes_of
 from ..limits.compare import user
 from ..limits.lines import OBLIQUITY, SPEED, LimitLine
-from ..limits.records import KIND_MAP, NAMES, attributes_of
+from ..provenance.code import summary as code_summary
 from ..storage.archive import Archive
-from ..storage.code_provenance import summary as code_summary
 from ..storage.records import LIMITS
 from .common import UsageError, say
 from .describe import seconds, shown

@@ -12,12 +12,12 @@ from collections.abc import Iterator
 import attrs
 import numpy as np
 
-from ..batch import SceneBatch
-from ..bodies import Plate, Sphere
-from ..results import RESULT_FIELDS, BatchResult, Outcome
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import Simulation
-from ..untrusted import spreadsheet_safe
+from ..base.untrusted import spreadsheet_safe
+from ..model.batch import SceneBatch
+from ..model.bodies import Plate, Sphere
+from ..model.results import RESULT_FIELDS, BatchResult, Outcome
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..run.simulation import Simulation
 
 #: Columns of the sweep CSV: the plate's label, the impact, then the result fields.
 SWEEP_COLUMNS = (

@@ -12,10 +12,10 @@ from typing import Any
 import numpy as np
 
 from .. import limits as lim
-from ..bodies import Sphere
-from ..errors import V50Error
-from ..progress import reporting_scenes
-from ..registry import PluginRegistry
+from ..base.errors import V50Error
+from ..model.bodies import Sphere
+from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
 from ..storage.shots import Shots
 from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
 from ..v50.fit import DEFAULT_BOOTSTRAP
@@ -234,7 +234,7 @@ def v50_command(args: argparse.Namespace) -> None:
         reasons = "; ".join(f"{math.degrees(o):g} deg: {r}" for o, r in results.items())
         raise V50Error(f"{args.shots}: no obliquity gives a V50; {reasons}")
     if args.png is not None:
-        from ..v50.figure import Panel, v50_figure  # noqa: PLC0415 (matplotlib only when drawing)
+        from ..figures.v50_fits import Panel, v50_figure  # noqa: PLC0415 (matplotlib only when drawing)
 
         panels = [
             Panel(f"{math.degrees(o):g} deg", groups[o].impact_speed, groups[o].perforated,

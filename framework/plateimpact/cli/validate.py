@@ -11,8 +11,8 @@ import numpy as np
 
 from ..experiment import MEASURED, PREDICTED, ValidationReport, validate
 from ..experiment.validation import MAX_VALIDATE_SCENES
-from ..progress import reporting_scenes
-from ..registry import PluginRegistry
+from ..registry.plugin_registry import PluginRegistry
+from ..run.progress import reporting_scenes
 from ..storage.shots import Shots
 from .common import add_dpi_option, check_directory, save_figure_atomically, say
 from .describe import shown
@@ -65,7 +65,7 @@ def validate_command(args: argparse.Namespace) -> None:
     check_directory(args.png, "--png", "figure")
     shots = Shots.from_csv(args.shots)
     if args.png is not None:
-        from ..experiment.figure import check_panels  # noqa: PLC0415 (matplotlib)
+        from ..figures.validation_panels import check_panels  # noqa: PLC0415 (matplotlib)
 
         check_panels(shots)
     choice = model_choice(args)
@@ -75,7 +75,7 @@ def validate_command(args: argparse.Namespace) -> None:
         bound = None if args.force else MAX_VALIDATE_SCENES
         report = validate(simulation, sphere, plate, shots, max_scenes=bound)
         if args.png is not None:
-            from ..experiment.figure import validation_figure  # noqa: PLC0415 (matplotlib)
+            from ..figures.validation_panels import validation_figure  # noqa: PLC0415 (matplotlib)
 
             figure = validation_figure(report, simulation, title=label)
     if args.png is not None:

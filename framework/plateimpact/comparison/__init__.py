@@ -3,7 +3,7 @@ ranges along impact speed (or obliquity) per plate (docs/archive.md, "Comparing 
 
 >>> comparison = results.compare("plugging", "large-pstar")
 >>> comparison.ranges()[0].pair, comparison.summary()["changes"]
->>> from plateimpact.comparison.figure import plot_comparison  # matplotlib: imported apart
+>>> from plateimpact.figures.compared_runs import plot_comparison  # matplotlib: imported apart
 """
 
 from __future__ import annotations

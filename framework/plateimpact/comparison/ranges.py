@@ -22,11 +22,11 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..batch import SceneBatch
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from ..limits.lines import OBLIQUITY, SPEED, unit_suffix
 from ..limits.regimes import Regime, regime_codes
-from ..results import BatchResult, Outcome
+from ..model.batch import SceneBatch
+from ..model.results import BatchResult, Outcome
 
 _DEG = math.pi / 180.0
 

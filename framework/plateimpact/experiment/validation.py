@@ -22,8 +22,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..bodies import MASS, RADIUS, Plate, Sphere
-from ..errors import ShotDataError, WorkBoundError
+from ..base.errors import ShotDataError, WorkBoundError
 from ..limits import (
     SPEED_RESOLUTION,
     SPEED_TOLERANCE,
@@ -33,10 +32,11 @@ from ..limits import (
     along_speed,
 )
 from ..limits.chunked import run_chunked
-from ..limits.find import check_steps
-from ..results import Outcome
-from ..scene import IMPACT_SPEED
-from ..simulation import Simulation
+from ..limits.plate_limits import check_steps
+from ..model.bodies import MASS, RADIUS, Plate, Sphere
+from ..model.results import Outcome
+from ..model.scene import IMPACT_SPEED
+from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
 from ..storage.shots import Shots
 
@@ -324,7 +324,7 @@ def validate(
     (:func:`plateimpact.limits.along_speed`). Before any scene runs: :class:`ShotDataError`
     when every shot has weight 0 (nothing to score), :class:`ParameterError` for a
     tolerance or resolution out of range, and
-    :class:`~plateimpact.errors.WorkBoundError` when the shots' scenes and the boundary
+    :class:`~plateimpact.base.errors.WorkBoundError` when the shots' scenes and the boundary
     search could together pass ``max_scenes`` (None: no bound; :func:`work_estimate`).
     The shots run RUN_CHUNK at a time.
     """

@@ -9,8 +9,12 @@ tolerance, for any model (docs/limits.md).
 
 from __future__ import annotations
 
+from .archived import archive_limits, read_limits, stored_limits
+from .bracketing import Located, locate
 from .compare import BoundaryShift, LimitsComparison, LineComparison, compare_limits
-from .find import (
+from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine
+from .maps import MAP_OBLIQUITIES, MAP_SPEED_SAMPLES, OutcomeMap, outcome_map, outcome_maps
+from .plate_limits import (
     MAX_SCAN_SCENES,
     OBLIQUITY_RANGE,
     OBLIQUITY_RESOLUTION,
@@ -22,10 +26,6 @@ from .find import (
     along_obliquity,
     along_speed,
 )
-from .finder import Located, locate
-from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine
-from .maps import MAP_OBLIQUITIES, MAP_SPEED_SAMPLES, OutcomeMap, outcome_map, outcome_maps
-from .records import archive_limits, read_limits, stored_limits
 from .regimes import REGIMES, Regime, regime_codes
 
 __all__ = [

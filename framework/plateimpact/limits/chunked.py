@@ -13,9 +13,9 @@ from concurrent.futures import Executor
 
 import numpy as np
 
-from ..batch import SceneBatch
-from ..results import BatchResult
-from ..simulation import DEFAULT_CHUNK_SIZE, Simulation
+from ..model.batch import SceneBatch
+from ..model.results import BatchResult
+from ..run.simulation import DEFAULT_CHUNK_SIZE, Simulation
 
 #: Scenes run in one batch: numpy's per-step overhead is spread over this many already
 #: (a sweep runs 10,000 at a time at the speed of one batch), and their results, some

@@ -15,10 +15,10 @@ from typing import Any, TypeVar
 
 import attrs
 
-from ..errors import ParameterError
-from .find import Limits
+from ..base.errors import ParameterError
 from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine, unit_suffix
 from .maps import OutcomeMap
+from .plate_limits import Limits
 from .regimes import Regime
 
 _DEG = math.pi / 180.0

@@ -11,7 +11,7 @@ from typing import Any
 
 import attrs
 
-from ..results import Outcome
+from ..model.results import Outcome
 from .regimes import Regime
 
 #: The two kinds of line: along impact speed at a fixed obliquity, or along obliquity at

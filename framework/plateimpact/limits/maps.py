@@ -1,7 +1,7 @@
 """The outcome map: the (impact speed, obliquity) plane on a grid, with every boundary
 located along each row of the grid.
 
-The grid is the finder's scan (limits.finder): one row per obliquity, the speeds equally
+The grid is the finder's scan (limits.bracketing): one row per obliquity, the speeds equally
 spaced, so the map costs one batch of rows × speeds scenes and the refinement passes of
 its boundaries. Its resolution is the grid's spacing: a band narrower than that may be
 missing from a row (``plateimpact limits`` finds every band of 1 m/s).
@@ -16,15 +16,23 @@ from concurrent.futures import Executor
 import attrs
 import numpy as np
 
-from ..bodies import Plate, Sphere
-from ..errors import ParameterError
-from ..parameters import check_instance
-from ..results import BatchResult
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..simulation import Simulation
-from .find import SPEED_RANGE, SPEED_TOLERANCE, Limits, _find, _floats, _interval, check_steps
-from .finder import RELATIVE_FLOOR, finest_tolerance, scan_points
+from ..base.errors import ParameterError
+from ..base.parameters import check_instance
+from ..model.bodies import Plate, Sphere
+from ..model.results import BatchResult
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..run.simulation import Simulation
+from .bracketing import RELATIVE_FLOOR, finest_tolerance, scan_points
 from .lines import SPEED
+from .plate_limits import (
+    SPEED_RANGE,
+    SPEED_TOLERANCE,
+    Limits,
+    _find,
+    _floats,
+    _interval,
+    check_steps,
+)
 from .regimes import Regime, regime_codes
 
 #: The default grid: 200 speeds over 50-2000 m/s, 86 obliquities 0-85 deg.

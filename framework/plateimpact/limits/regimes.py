@@ -12,7 +12,7 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from ..results import BatchResult, Outcome
+from ..model.results import BatchResult, Outcome
 
 
 @attrs.frozen(order=True)

@@ -22,13 +22,13 @@ from typing import Protocol
 import h5py
 import numpy as np
 
-from ..batch import CORE_COLUMNS, SceneBatch
-from ..errors import ArchiveError
-from ..parameters import Parameter
-from ..registry import default_registry
-from ..results import BatchResult
-from ..untrusted import printable
-from ..variant import Variant
+from ..base.errors import ArchiveError
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
+from ..model.batch import CORE_COLUMNS, SceneBatch
+from ..model.results import BatchResult
+from ..registry.plugin_registry import default_registry
+from ..run.variant import Variant
 from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed
 from .data_files import (  # noqa: F401 (data_directory and encoded: their public home)

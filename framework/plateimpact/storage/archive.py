@@ -23,12 +23,12 @@ import attrs
 import h5py
 import numpy as np
 
-from ..batch import SceneBatch
-from ..errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
-from ..parameters import Parameter
-from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
-from ..untrusted import printable
-from ..variant import Variant
+from ..base.errors import ArchiveError, ParameterError, PlateImpactError, UnknownNameError
+from ..base.parameters import Parameter
+from ..base.untrusted import printable
+from ..model.batch import SceneBatch
+from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from ..run.variant import Variant
 from . import append as append_module
 from . import records
 from . import stored_attributes as typed

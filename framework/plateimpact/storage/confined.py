@@ -36,8 +36,8 @@ from typing import BinaryIO
 
 import numpy as np
 
-from ..errors import ArchiveError
-from ..untrusted import printable
+from ..base.errors import ArchiveError
+from ..base.untrusted import printable
 from .output import TEMPORARY_EXTRA, pid_alive, temporary_owner, umask
 
 #: A data file's name: ``SLUG.XXXXXXXX.nc`` (the slug of study and run, at most 60

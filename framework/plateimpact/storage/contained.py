@@ -22,8 +22,8 @@ from pathlib import Path
 import h5py
 from h5py import h5d, h5l, h5o
 
-from ..errors import ArchiveError
-from ..untrusted import printable
+from ..base.errors import ArchiveError
+from ..base.untrusted import printable
 from .confined import Opened, data_file_name, directory, is_hdf5, open_regular
 
 #: The most links a file of an archive may hold (an index of 10**5 runs holds about

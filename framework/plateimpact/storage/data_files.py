@@ -13,7 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import BinaryIO
 
-from ..errors import ArchiveError
+from ..base.errors import ArchiveError
 from .confined import (
     DATA_NAME,
     data_file_name,

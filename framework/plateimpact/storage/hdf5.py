@@ -9,8 +9,8 @@ import json
 import h5py
 import numpy as np
 
-from ..parameters import Parameter
-from ..ragged import Ragged
+from ..base.parameters import Parameter
+from ..model.ragged import Ragged
 
 #: Attribute holding the SHA-256 of a study's, run's or stored record's other attributes.
 SEAL = "attributes_sha256"

@@ -29,8 +29,8 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..errors import ArchiveError, ArchiveWaitWarning
-from ..untrusted import printable
+from ..base.errors import ArchiveError, ArchiveWaitWarning
+from ..base.untrusted import printable
 
 #: How often a waiting writer looks again [s].
 POLL = 0.05

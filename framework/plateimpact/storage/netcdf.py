@@ -21,11 +21,11 @@ from typing import Any, BinaryIO
 import h5py
 import numpy as np
 
-from ..errors import ArchiveError
-from ..parameters import Parameter
-from ..ragged import Ragged
-from ..results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
-from ..untrusted import load_json
+from ..base.errors import ArchiveError
+from ..base.parameters import Parameter
+from ..base.untrusted import load_json
+from ..model.ragged import Ragged
+from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
 from .hdf5 import digest
 
 SCENE, SAMPLE, POINT = "scene", "trajectory_sample", "crater_point"

@@ -25,8 +25,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import IO
 
-from ..errors import PlateImpactError
-from ..untrusted import printable
+from ..base.errors import PlateImpactError
+from ..base.untrusted import printable
 
 #: What ``kind`` may end with; ``None``: any name.
 SUFFIXES: dict[str, tuple[str, ...] | None] = {

@@ -19,11 +19,11 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from ..bodies import THICKNESS, Plate
-from ..errors import ParameterError, PlateFileError
-from ..parameters import Parameter
-from ..registry import PluginRegistry, default_registry
-from ..untrusted import described, load_json_file, printable
+from ..base.errors import ParameterError, PlateFileError
+from ..base.parameters import Parameter
+from ..base.untrusted import described, load_json_file, printable
+from ..model.bodies import THICKNESS, Plate
+from ..registry.plugin_registry import PluginRegistry, default_registry
 from .output import write_text
 
 FORMAT = "plateimpact-plate-1"

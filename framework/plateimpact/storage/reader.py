@@ -12,9 +12,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from ..errors import ArchiveError, PlateImpactError
-from ..ragged import Ragged
-from ..untrusted import printable
+from ..base.errors import ArchiveError, PlateImpactError
+from ..base.untrusted import printable
+from ..model.ragged import Ragged
 from .append import FORMAT, FORMAT_VERSION, READABLE_VERSIONS
 from .confined import SLACK, Opened, check_lengths, open_regular, shown_version
 from .contained import check_once, data_file, index_link_allowed, open_hdf5

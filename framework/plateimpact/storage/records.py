@@ -19,8 +19,8 @@ import attrs
 import h5py
 import numpy as np
 
-from ..errors import ArchiveError, ParameterError
-from ..untrusted import printable
+from ..base.errors import ArchiveError, ParameterError
+from ..base.untrusted import printable
 from .append import append_with
 from .data_files import DataFiles
 from .hdf5 import seal, write_dataset
@@ -33,7 +33,7 @@ RESERVED_NAMES = ("runs", "scenes")
 
 
 @attrs.frozen(eq=False)
-class Column:
+class RecordColumn:
     """One dataset of a record: ``data`` [``units``, SI; "1" for none]. Read back, a
     column has its data only (storage.records.read_record)."""
 
@@ -49,7 +49,7 @@ class Record:
     ``columns`` by their path inside the record's group (``lines/fixed``)."""
 
     attributes: dict[str, object]
-    columns: dict[str, Column]
+    columns: dict[str, RecordColumn]
 
 
 def is_container(f: h5py.File, name: str) -> bool:
@@ -190,4 +190,6 @@ def read_record(
             found.append(name)
 
     group.visititems(visit)
-    return Record(attributes, {where: Column(read(group[where].name), "", "") for where in found})
+    return Record(
+        attributes, {where: RecordColumn(read(group[where].name), "", "") for where in found}
+    )

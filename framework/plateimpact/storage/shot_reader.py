@@ -17,7 +17,7 @@ from typing import TextIO, overload
 
 import numpy as np
 
-from ..errors import ShotDataError
+from ..base.errors import ShotDataError
 from .shot_rows import (
     PERFORATION_COLUMNS,
     REQUIRED_COLUMNS,

@@ -13,11 +13,11 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
-from ..bodies import MASS, RADIUS
-from ..errors import ShotDataError
-from ..parameters import Parameter
-from ..results import RESULT_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY, IMPACT_SPEED
+from ..base.errors import ShotDataError
+from ..base.parameters import Parameter
+from ..model.bodies import MASS, RADIUS
+from ..model.results import RESULT_FIELDS, Outcome
+from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 
 RESIDUAL_SPEED = Parameter(
     "residual_speed",

@@ -12,7 +12,7 @@ free-text source. The CSV header names the columns, in any order:
 with at least one of ``outcome``, ``perforated`` and ``residual_speed_m_s``. Lines
 starting with ``#`` are comments; other columns are ignored; a UTF-8 byte order mark and
 CRLF line ends are read. The file is read a row at a time (:mod:`.shot_reader`): the
-first bad value raises :class:`~plateimpact.errors.ShotDataError` at once, with one line
+first bad value raises :class:`~plateimpact.base.errors.ShotDataError` at once, with one line
 naming the file, line, column and value (and how many of the next 10,000 rows are bad);
 what the outcome, ``perforated`` and residual speed say must agree; a set holds at most
 :data:`MAX_SHOTS` shots (docs/calibration.md, "1. Shot data").
@@ -29,13 +29,13 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
-from ..batch import SceneBatch
-from ..bodies import MASS, RADIUS, Plate, Sphere, check_density
-from ..errors import ParameterError, ShotDataError
-from ..parameters import Parameter
-from ..results import RESULT_FIELDS, Outcome
-from ..scene import IMPACT_OBLIQUITY
-from ..untrusted import check_input, spreadsheet_safe
+from ..base.errors import ParameterError, ShotDataError
+from ..base.parameters import Parameter
+from ..base.untrusted import check_input, spreadsheet_safe
+from ..model.batch import SceneBatch
+from ..model.bodies import MASS, RADIUS, Plate, Sphere, check_density
+from ..model.results import RESULT_FIELDS, Outcome
+from ..model.scene import IMPACT_OBLIQUITY
 from .shot_reader import (
     MAX_SHOTS,
     ShotColumns,
@@ -71,7 +71,7 @@ class Shots:
     Attributes
     ----------
     impact_speed : numpy.ndarray
-        Vs [m/s], in the range of :data:`~plateimpact.scene.IMPACT_SPEED`.
+        Vs [m/s], in the range of :data:`~plateimpact.model.scene.IMPACT_SPEED`.
     impact_obliquity : numpy.ndarray
         θs [rad], in [0, π/2).
     residual_speed : numpy.ndarray

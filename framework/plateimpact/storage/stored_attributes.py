@@ -3,8 +3,8 @@
 An archive's attributes are sealed by a digest (``attributes_sha256``), but anyone who
 edits them can recompute it, so a sealed value is still untrusted input. Each reader
 here returns the value the format says (text, a number, a JSON object or list of the
-right shape) or raises a one-line :class:`~plateimpact.errors.ArchiveError` naming the
-attribute: JSON goes through :func:`plateimpact.untrusted.load_json` (depth, size, integer
+right shape) or raises a one-line :class:`~plateimpact.base.errors.ArchiveError` naming the
+attribute: JSON goes through :func:`plateimpact.base.untrusted.load_json` (depth, size, integer
 digits, duplicate keys, NaN), never ``json.loads``.
 """
 
@@ -14,9 +14,9 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from ..errors import ArchiveError, PlateImpactError
-from ..untrusted import load_json, printable
-from ..variant import Variant
+from ..base.errors import ArchiveError, PlateImpactError
+from ..base.untrusted import load_json, printable
+from ..run.variant import Variant
 
 #: Run attributes holding a JSON object, and those holding text.
 JSON_OBJECTS = ("variant", "model", "versions", "failure_state_units")

@@ -24,9 +24,9 @@ from typing import BinaryIO
 
 import h5py
 
-from ..errors import ArchiveError
-from ..registry import default_registry
-from ..untrusted import printable
+from ..base.errors import ArchiveError
+from ..base.untrusted import printable
+from ..registry.plugin_registry import default_registry
 from . import stored_attributes as typed
 from .append import FORMAT, FORMAT_VERSION, add_run
 from .archive import WAIT, Archive

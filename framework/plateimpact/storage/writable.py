@@ -9,8 +9,8 @@ import os
 import stat
 from pathlib import Path
 
-from ..errors import ArchiveError
-from ..untrusted import printable
+from ..base.errors import ArchiveError
+from ..base.untrusted import printable
 from . import confined, records
 from .append import FORMAT_VERSION
 from .confined import check_lengths, shown_version

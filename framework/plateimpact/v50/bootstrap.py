@@ -32,7 +32,7 @@ import math
 import attrs
 import numpy as np
 
-from ..errors import V50Error
+from ..base.errors import V50Error
 from .likelihood import Link, prepared
 from .profile import Interval
 from .solver import maximum

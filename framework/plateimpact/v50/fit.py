@@ -13,7 +13,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..errors import ParameterError
+from ..base.errors import ParameterError
 from .bootstrap import bootstrap_intervals
 from .likelihood import PROBIT, check_arrays, check_shots, increasing, link_of, prepared, rounds
 from .profile import Interval, profile_intervals
@@ -127,11 +127,11 @@ def fit_v50(
     are taken in one order (by speed, outcome, weight), so the fit and its bootstrap do
     not depend on the order given.
 
-    Raises :class:`~plateimpact.errors.V50Error` (one line) for fewer than 4 shots
+    Raises :class:`~plateimpact.base.errors.V50Error` (one line) for fewer than 4 shots
     (weights counted), only one outcome, outcomes separated by a speed (the likelihood
     has no maximum), or a fit that finds perforation less likely at higher speeds (a
     fit that does not converge would be refused too: none is known);
-    :class:`~plateimpact.errors.ParameterError` for bad arguments.
+    :class:`~plateimpact.base.errors.ParameterError` for bad arguments.
     """
     link = link_of(method)
     _check_options(confidence, bootstrap)

@@ -28,7 +28,7 @@ import attrs
 import numpy as np
 from scipy import special
 
-from ..errors import ParameterError, V50Error
+from ..base.errors import ParameterError, V50Error
 
 #: The fits, by name.
 PROBIT, LOGIT = "probit", "logit"
@@ -110,7 +110,7 @@ class GoNoGo:
 
 
 @attrs.frozen
-class Estimate:
+class LikelihoodMaximum:
     """The maximum of the likelihood: z = intercept + slope x, x in the units of GoNoGo;
     for slope > 0, z = (x − location)/scale."""
 
@@ -209,7 +209,7 @@ def prepared(speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray) -> G
     return GoNoGo((v - centre) / spread, sign, w, centre, spread)
 
 
-def increasing(best: Estimate, label: str) -> Estimate:
+def increasing(best: LikelihoodMaximum, label: str) -> LikelihoodMaximum:
     """``best``, refused unless perforation becomes more likely with speed."""
     if best.slope <= 0.0:
         raise V50Error(

@@ -20,7 +20,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..errors import ParameterError, V50Error
+from ..base.errors import ParameterError, V50Error
 from .likelihood import check_arrays
 
 #: Shots of each outcome the standard averages (four-, six- and ten-round limits).
@@ -89,7 +89,7 @@ def mil_std_662f(
 
     ``count`` (2, 3 or 5) partial and as many complete penetrations are averaged; None
     takes the most that lie within ``spread_m_s`` [m/s] (default 38.1 m/s, 125 ft/s).
-    Raises :class:`~plateimpact.errors.V50Error` (one line naming the shots ``label``)
+    Raises :class:`~plateimpact.base.errors.V50Error` (one line naming the shots ``label``)
     when the shots do not meet the standard's conditions.
     """
     v, y, w = check_arrays(speed, perforated, weight)

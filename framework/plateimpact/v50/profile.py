@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 from scipy import optimize, stats
 
-from .likelihood import Estimate, GoNoGo, Link
+from .likelihood import GoNoGo, LikelihoodMaximum, Link
 
 #: An interval [low, high]; None for an end the data do not bound.
 Interval = tuple[float | None, float | None]
@@ -39,7 +39,7 @@ def threshold(confidence: float) -> float:
 
 
 def quantile_profile(
-    shots: GoNoGo, link: Link, p: float, best: Estimate
+    shots: GoNoGo, link: Link, p: float, best: LikelihoodMaximum
 ) -> Callable[[float], float]:
     """−log L maximised over the scale, with the p-quantile fixed at t [x units]."""
     q = link.quantile(p)
@@ -58,7 +58,7 @@ def quantile_profile(
     return at
 
 
-def scale_profile(shots: GoNoGo, link: Link, best: Estimate) -> Callable[[float], float]:
+def scale_profile(shots: GoNoGo, link: Link, best: LikelihoodMaximum) -> Callable[[float], float]:
     """−log L maximised over the location, with log(scale) fixed [log x units]."""
 
     def at(log_scale: float) -> float:
@@ -93,7 +93,7 @@ def interval_end(
 
 
 def _interval(
-    profile: Callable[[float], float], best: Estimate, centre: float, step: float,
+    profile: Callable[[float], float], best: LikelihoodMaximum, centre: float, step: float,
     limits: tuple[float, float], confidence: float,
 ) -> tuple[float | None, float | None]:  # fmt: skip
     level = best.negative_log_likelihood + 0.5 * threshold(confidence)
@@ -108,7 +108,7 @@ def _interval(
 
 
 def profile_intervals(
-    shots: GoNoGo, link: Link, best: Estimate, confidence: float, levels: dict[str, float]
+    shots: GoNoGo, link: Link, best: LikelihoodMaximum, confidence: float, levels: dict[str, float]
 ) -> dict[str, Interval]:
     """The profile intervals [m/s] of the quantiles ``levels`` (name -> p) and of
     ``sigma`` (the standard deviation of F)."""

@@ -20,8 +20,8 @@ from collections.abc import Callable
 import numpy as np
 from scipy import optimize
 
-from ..errors import V50Error
-from .likelihood import Estimate, GoNoGo, Link
+from ..base.errors import V50Error
+from .likelihood import GoNoGo, LikelihoodMaximum, Link
 
 #: A maximum is accepted where |d(−log L)/dβ| <= this × the total weight (the rounds);
 #: Newton's method takes at most this many steps (a convex problem takes fewer than 20,
@@ -107,7 +107,7 @@ def _trust_region(problem: Problem, start: np.ndarray, tolerance: float) -> tupl
     return np.asarray(found.x, dtype=float), int(found.nit)
 
 
-def maximum(shots: GoNoGo, link: Link, label: str) -> Estimate:
+def maximum(shots: GoNoGo, link: Link, label: str) -> LikelihoodMaximum:
     """The maximum of the likelihood (β0, β1): Newton from the best flat curve, then the
     trust-region solver from where Newton stopped if that is not a maximum. V50Error
     (one line) if neither reaches a gradient within the tolerance, which the shots
@@ -134,7 +134,7 @@ def maximum(shots: GoNoGo, link: Link, label: str) -> Estimate:
                 f"after {steps} steps"
             )
     value = problem(beta)[0]
-    return Estimate(float(beta[0]), float(beta[1]), value, steps)
+    return LikelihoodMaximum(float(beta[0]), float(beta[1]), value, steps)
 
 
 __all__ = ["GRADIENT_TOLERANCE", "MAX_ITERATIONS", "flat_start", "maximum", "newton"]

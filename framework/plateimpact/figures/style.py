@@ -1,0 +1,59 @@
+"""The page every figure is drawn for: journal widths and font sizes, one colour per
+regime and one line style per run, and a new figure outside pyplot.
+
+Figures are made as :class:`matplotlib.figure.Figure` objects, not through pyplot:
+nothing here touches the user's backend or pyplot's state, so the functions work the
+same in a script, a notebook and an interactive session. Functions draw on axes you pass
+and return them; :func:`figure` gives a figure and its axes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+
+from ..limits.regimes import REGIMES, Regime
+
+
+def figure(nrows: int = 1, ncols: int = 1, **kwargs: Any) -> tuple[Figure, Any]:
+    """A new figure (outside pyplot) and its axes, as ``pyplot.subplots`` returns them."""
+    fig = Figure(figsize=kwargs.pop("figsize", None), layout=kwargs.pop("layout", None))
+    return fig, fig.subplots(nrows, ncols, **kwargs)
+
+
+#: Journal widths [in]: one column, two columns (the page).
+COLUMN_WIDTH, PAGE_WIDTH = 3.5, 7.2
+#: Font sizes [pt] of figures drawn at journal width: labels and titles, ticks and keys.
+FONT, SMALL = 7.0, 6.0
+#: The most columns of panels a study figure has; more obliquities make more rows.
+MAX_COLUMNS = 4
+
+#: One colour per regime, shared by the family figures' outcome strips and the outcome
+#: maps (figures.limits_and_maps); the thin-plate band (ricochet after failure) stands out.
+REGIME_COLOURS = {
+    REGIMES[0]: "#4c72b0",  # ricochet
+    REGIMES[1]: "#a05fc0",  # ricochet after failure
+    REGIMES[2]: "#dd8452",  # embedment
+    REGIMES[3]: "#e6c85a",  # embedment after failure
+    REGIMES[4]: "#55a868",  # perforation
+}
+#: Line colours and styles of a study's runs, in order (black and dashed read in print).
+RUN_STYLES: list[dict[str, Any]] = [
+    {"color": "k", "ls": "-"},
+    {"color": "C3", "ls": "--"},
+    {"color": "C0", "ls": ":"},
+    {"color": "C2", "ls": "-."},
+    {"color": "C4", "ls": (0, (5, 1))},
+]
+
+
+def regime_colour(regime: Regime) -> str:
+    return REGIME_COLOURS.get(regime, "#999999")
+
+
+def regime_key(regimes: Sequence[Regime] | set[Regime]) -> list[Patch]:
+    """Legend handles: one coloured patch per regime present, in the order of REGIMES."""
+    return [Patch(color=regime_colour(r), label=r.label) for r in REGIMES if r in regimes]

@@ -1,0 +1,66 @@
+"""What every plug-in shares: its name, version, declarations and settings.
+
+A plug-in declares what it needs from the plate (:attr:`Plugin.plate_constants`) and
+what it computes once per batch (:attr:`Plugin.columns`); its settings are its attrs
+fields, declared with :meth:`Parameter.field <plateimpact.base.parameters.Parameter.field>`.
+The core validates and namespaces all of it, so a plug-in never sees, and never
+overwrites, another's columns.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import attrs
+
+from ..base.parameters import Parameter, declared_settings
+
+
+@attrs.frozen
+class Column:
+    """A per-scene column a plug-in computes once per batch in ``prepare``.
+
+    ``name`` is how the plug-in reads it back (``batch.failure_plane_depth``); ``unit``
+    [SI] and ``description`` document it.
+    """
+
+    name: str
+    unit: str
+    description: str
+
+
+class Plugin:
+    """Base of :class:`~plateimpact.ResistanceLaw`, :class:`~plateimpact.FailureModel`
+    and :class:`~plateimpact.Integrator`.
+
+    Class attributes
+    ----------------
+    name : str
+        The name users select it by.
+    version : str
+        Recorded in archives: change it when results change.
+    plate_constants : tuple of Parameter
+        The plate constants it reads (``batch.a``): name, SI unit, range, default, flag.
+        Two plug-ins may share a constant only through equal declarations (reuse the
+        object, e.g. ``plateimpact_plugins.STRENGTH_A``).
+    columns : tuple of Column
+        The per-scene columns its ``prepare`` returns.
+    """
+
+    name: ClassVar[str]
+    version: ClassVar[str] = "1"
+    plate_constants: ClassVar[tuple[Parameter, ...]] = ()
+    columns: ClassVar[tuple[Column, ...]] = ()
+
+    @classmethod
+    def setting_declarations(cls) -> dict[str, Parameter]:
+        """Its settings (attrs fields) by name, each with its declaration."""
+        return declared_settings(cls)
+
+    def settings(self) -> dict[str, Any]:
+        """Every setting, as JSON values [SI], for outputs and archives: all its attrs
+        fields, so nothing set is ever missing from a record."""
+        return {
+            name: declared.json_value(getattr(self, name))
+            for name, declared in self.setting_declarations().items()
+        }

@@ -1,0 +1,88 @@
+"""The ResistanceLaw interface: the stress the plate exerts on the presented area."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from .batch import SceneBatch
+from .geometry import contact_geometry
+from .plugin import Plugin
+
+
+class ResistanceLaw(Plugin, ABC):
+    """How hard the plate pushes back, per unit of presented area.
+
+    The core computes the contact geometry (presented area A and the force's inclination
+    φ, eqs 2–6); a resistance law supplies the stress σ so that the force is F = A σ,
+    directed along the contact-plane normal, at ψ = θ − φ from the sphere's path.
+
+    To write one: subclass, set ``name``, declare the plate constants it reads in
+    ``plate_constants``, implement :meth:`stress` on arrays, and register the class from
+    a ``plateimpact_register`` hook (:mod:`plateimpact.registry.hookspecs`). Settings are attrs
+    fields. ``stress`` runs inside the step loop: numpy only, no Python loop over
+    scenes, no hook calls.
+    """
+
+    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
+        """The per-scene columns declared in ``columns``, computed once per batch before
+        any step (default none)."""
+        return {}
+
+    @abstractmethod
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
+        """Stress on the presented area [N/m²].
+
+        Parameters
+        ----------
+        speed : V [m/s], one per scene of ``batch``.
+        incidence : ψ [rad], the angle between the path and the force's line.
+        batch : this law's view of the scenes: the core columns, the plate constants it
+            declared (``batch.a``) and the columns it prepared.
+        """
+
+
+def contact_force(
+    law: ResistanceLaw,
+    penetration: np.ndarray,
+    obliquity: np.ndarray,
+    speed: np.ndarray,
+    batch: SceneBatch,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Drag and lift [N] of ``law`` on the contact surface (eqs 1, 22–24) at
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``speed`` V [m/s], one per scene.
+
+    ``penetration`` is measured from the plane bounding the resisting material: the front
+    surface for the intact force F*, the failure plane (P − h) for the relieved force F′
+    of eqs 9–14. Drag opposes the motion; positive lift turns θ upward (toward ricochet).
+    ``batch`` is the law's view of the scenes.
+    """
+    area, inclination = contact_geometry(penetration, obliquity, batch.radius)
+    incidence = obliquity - inclination  # ψ, eq 22
+    force = area * law.stress(speed, incidence, batch)  # eq 1
+    return force * np.cos(incidence), force * np.sin(incidence)  # eqs 23, 24
+
+
+class BoundResistance:
+    """The model's resistance law on its own view of a set of scenes: what a failure
+    model is given to compute forces on parts of the contact surface (the relieved force
+    F′ beyond a failure plane, a hinged finger) without seeing the law's columns."""
+
+    __slots__ = ("batch", "law")
+
+    def __init__(self, law: ResistanceLaw, batch: SceneBatch) -> None:
+        self.law = law
+        self.batch = batch
+
+    def stress(self, speed: np.ndarray, incidence: np.ndarray) -> np.ndarray:
+        """σ [N/m²] at speed V [m/s] and incidence ψ [rad]."""
+        return self.law.stress(speed, incidence, self.batch)
+
+    def contact_force(
+        self, penetration: np.ndarray, obliquity: np.ndarray, speed: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Drag and lift [N] on the contact surface below a plane ``penetration`` [m] above
+        the sphere's deepest point, at ``obliquity`` θ [rad] and ``speed`` V [m/s]
+        (:func:`contact_force`)."""
+        return contact_force(self.law, penetration, obliquity, speed, self.batch)

@@ -1,0 +1,115 @@
+"""A model variant: plug-in names and settings, as a study and its archive record them."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from typing import Any
+
+import attrs
+import numpy as np
+
+from ..base.errors import ParameterError
+from ..base.untrusted import load_json
+from ..model.impact import REST_SPEED_FRACTION
+from ..registry.plugin_registry import PluginRegistry
+from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+
+
+def _json_value(value: object) -> object:
+    """Settings as JSON values, so that a variant is archived and read back unchanged."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if hasattr(value, "as_setting"):  # e.g. a PstarTable: its rows
+        return value.as_setting()
+    raise ParameterError("settings", f"setting value {value!r} is not a JSON value")
+
+
+def _settings(value: Mapping[str, Any] | None) -> dict[str, Any]:
+    if value is not None and not isinstance(value, Mapping):
+        raise ParameterError(
+            "settings", f"settings must be a mapping of names to values, got {value!r:.80}"
+        )
+    if not all(isinstance(name, str) for name in value or {}):
+        raise ParameterError("settings", f"setting names must be strings, got {list(value or {})}")
+    settings: dict[str, Any] = json.loads(
+        json.dumps(dict(value or {}), default=_json_value, sort_keys=True)
+    )
+    return settings
+
+
+def check_name(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    """A study or run name, which names an archive group: non-empty, printable (no NUL,
+    which HDF5 would cut the name at), no '/', no surrounding space."""
+    name = value if isinstance(value, str) else ""
+    if not name or name != name.strip() or "/" in name or not name.isprintable():
+        raise ParameterError(
+            attribute.name,
+            f"{attribute.name} must be a printable name without '/' or surrounding space, "
+            f"got {value!r}",
+        )
+
+
+def check_plugin_name(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    """A plug-in name: a string (which plug-in it names is checked when it is run)."""
+    if not isinstance(value, str):
+        raise ParameterError(
+            attribute.name, f"{attribute.name} must be a plug-in name, got {value!r:.60}"
+        )
+
+
+@attrs.frozen
+class Variant:
+    """One model variant of a study: plug-in names and their settings [SI].
+
+    Settings are held as JSON values (a :class:`PstarTable` becomes its rows), exactly as
+    the archive stores them, so a variant read back from an archive equals this one.
+    """
+
+    name: str = attrs.field(validator=check_name)
+    resistance: str = attrs.field(default=DEFAULT_RESISTANCE, validator=check_plugin_name)
+    failure: str = attrs.field(default=DEFAULT_FAILURE, validator=check_plugin_name)
+    integrator: str = attrs.field(default=DEFAULT_INTEGRATOR, validator=check_plugin_name)
+    resistance_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
+    failure_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
+    integrator_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
+    rest_speed_fraction: float = REST_SPEED_FRACTION.field()
+
+    def simulation(self, registry: PluginRegistry | None = None) -> Simulation:
+        """The resolved model and integrator (plug-ins looked up by name once)."""
+        return Simulation.from_names(
+            self.resistance,
+            self.failure,
+            self.integrator,
+            resistance_settings=self.resistance_settings,
+            failure_settings=self.failure_settings,
+            integrator_settings=self.integrator_settings,
+            rest_speed_fraction=self.rest_speed_fraction,
+            registry=registry,
+        )
+
+    def to_json(self) -> str:
+        return json.dumps(attrs.asdict(self), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> Variant:
+        """The variant of :meth:`to_json`'s text (an archive's record, which may come from
+        anyone): malformed or too deeply nested JSON, a key given twice, an unknown key
+        or a value of the wrong type is a one-line ParameterError."""
+        data = load_json(text, "variant", _variant_error)
+        if not isinstance(data, dict):
+            raise ParameterError("variant", f"variant: expected a JSON object, got {data!r:.60}")
+        known = {field.name for field in attrs.fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ParameterError(
+                "variant",
+                f"variant: unknown key {unknown[0]!r:.60} (known: {', '.join(sorted(known))})",
+            )
+        return cls(**data)
+
+
+def _variant_error(message: str) -> ParameterError:
+    return ParameterError("variant", message)
