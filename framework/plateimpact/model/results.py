@@ -9,9 +9,8 @@ import attrs
 import numpy as np
 
 from ..base.parameters import Parameter
+from ..base.units import deg, mm
 from .ragged import Ragged
-
-_DEG, _MM = math.pi / 180.0, 1e-3
 
 
 class Outcome(enum.IntEnum):
@@ -39,11 +38,11 @@ RESULT_FIELDS: dict[str, Parameter] = {
             "direction from the plate normal when contact ends, or at rest",
             "rad",
             display_unit="deg",
-            scale=_DEG,
+            scale=deg,
         ),
         Parameter("contact_time", "time from first contact to the outcome", "s"),
         Parameter(
-            "max_penetration", "largest penetration P reached", "m", display_unit="mm", scale=_MM
+            "max_penetration", "largest penetration P reached", "m", display_unit="mm", scale=mm
         ),
         Parameter(
             "plate_failed", "whether the plate failed (P reached the onset penetration)", kind=bool
@@ -54,14 +53,14 @@ RESULT_FIELDS: dict[str, Parameter] = {
             "penetration at plate failure (NaN: none)",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
         Parameter(
             "failure_lateral",
             "lateral displacement at plate failure (NaN: none)",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
     )
 }
@@ -75,21 +74,21 @@ TRAJECTORY_FIELDS: dict[str, Parameter] = {
             "depth P of the sphere's deepest point below the front surface",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
         Parameter(
             "lateral",
             "lateral displacement Y of the sphere's centre",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
         Parameter(
             "obliquity",
             "direction theta of the velocity from the plate normal",
             "rad",
             display_unit="deg",
-            scale=_DEG,
+            scale=deg,
         ),
         Parameter("speed", "speed V", "m/s"),
     )
@@ -103,21 +102,21 @@ CRATER_FIELDS: dict[str, Parameter] = {
             "distance along the plate from the crater's entry point",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
         Parameter(
             "depth",
             "depth of the crater floor below the front surface",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
         Parameter(
             "impact_point",
             "lateral position of first contact in the section's coordinates",
             "m",
             display_unit="mm",
-            scale=_MM,
+            scale=mm,
         ),
     )
 }
