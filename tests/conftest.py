@@ -168,3 +168,20 @@ def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
         code = main(["reproduce", "--quick", "--out", str(out), "--dpi", "50"])
     assert code == 0, errors.getvalue()
     return out
+
+
+@pytest.fixture
+def chunks(monkeypatch):
+    """The sizes of the chunks of scenes run (``run.simulation.run_chunk``, where the one
+    dispatch of runs and studies looks it up), in order."""
+    from plateimpact.run import simulation  # noqa: PLC0415
+
+    sizes: list[int] = []
+    real = simulation.run_chunk
+
+    def counted(sim, bound, *args):
+        sizes.append(bound.size)
+        return real(sim, bound, *args)
+
+    monkeypatch.setattr(simulation, "run_chunk", counted)
+    return sizes

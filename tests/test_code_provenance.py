@@ -24,7 +24,6 @@ import pytest
 from conftest import THIRD_PARTY
 
 import plateimpact as pi
-import plateimpact.run.simulation as simulation_module
 from plateimpact import limits, presets
 from plateimpact.cli import main
 from plateimpact.provenance import code as code_provenance
@@ -87,20 +86,6 @@ def installed() -> pi.PluginRegistry:
     return pi.load_registry()
 
 
-@pytest.fixture
-def scenes_run(monkeypatch):
-    """The sizes of the chunks of scenes the studies compute."""
-    sizes: list[int] = []
-    real = simulation_module.run_chunk
-
-    def counted(simulation, chunk, *args):
-        sizes.append(chunk.size)
-        return real(simulation, chunk, *args)
-
-    monkeypatch.setattr(simulation_module, "run_chunk", counted)
-    return sizes
-
-
 def rate_study() -> pi.Study:
     return pi.Study.grid("rate", [PLATE], [0, 45], np.linspace(200.0, 900.0, 5), VARIANT)
 
@@ -116,11 +101,11 @@ def files_of(path: Path) -> dict[str, bytes]:
 
 
 def test_a_changed_plug_in_is_refused_on_resume_and_an_unchanged_one_resumed(
-    site, tmp_path, scenes_run
+    site, tmp_path, chunks
 ):
     study, path = rate_study(), tmp_path / "a.h5"
     first = study.run(archive=path, registry=installed())
-    assert sum(scenes_run) == study.scenes.size
+    assert sum(chunks) == study.scenes.size
     recorded = pi.Archive(path).metadata("rate")["plugins"]["resistance"]
     old = isotropic_sha256(site)
     assert recorded["source_sha256"] == old
@@ -129,9 +114,9 @@ def test_a_changed_plug_in_is_refused_on_resume_and_an_unchanged_one_resumed(
     )  # fmt: skip
     assert recorded["entry_point"] == "isotropic = plateimpact_isotropic"
     # The same code loaded again: the run is read back, no scene computed.
-    scenes_run.clear()
+    chunks.clear()
     again = study.run(archive=path, resume=True, registry=installed())
-    assert scenes_run == []
+    assert chunks == []
     np.testing.assert_array_equal(again["rate"].exit_speed, first["rate"].exit_speed)
     # A new release of the law: resume refuses, before any scene, and changes nothing.
     source = site / PACKAGE / "__init__.py"
@@ -147,28 +132,28 @@ def test_a_changed_plug_in_is_refused_on_resume_and_an_unchanged_one_resumed(
             f"(resistance rate-poncelet: source sha256 {old[:12]} -> {new[:12]}); "
             "overwrite=True replaces it, run_names stores the new run under another name"
         )
-    assert scenes_run == [] and files_of(path) == before
+    assert chunks == [] and files_of(path) == before
     # Told to, it replaces the run with one the new code computes, which differs.
     replaced = study.run(archive=path, overwrite=True, registry=registry)
-    assert sum(scenes_run) == study.scenes.size
+    assert sum(chunks) == study.scenes.size
     assert not np.array_equal(replaced["rate"].exit_speed, first["rate"].exit_speed)
     stored = pi.Archive(path).metadata("rate")["plugins"]["resistance"]["source_sha256"]
     assert stored == new
-    scenes_run.clear()
+    chunks.clear()
     study.run(archive=path, resume=True, registry=registry)
-    assert scenes_run == []
+    assert chunks == []
 
 
-def test_a_new_version_of_the_distribution_is_refused_on_resume(site, tmp_path, scenes_run):
+def test_a_new_version_of_the_distribution_is_refused_on_resume(site, tmp_path, chunks):
     study, path = rate_study(), tmp_path / "a.h5"
     study.run(archive=path, registry=installed())
     metadata = site / f"{PACKAGE}-0.1.dist-info" / "METADATA"
     metadata.write_text(metadata.read_text().replace("Version: 0.1", "Version: 0.2"))
-    scenes_run.clear()
+    chunks.clear()
     with pytest.raises(StaleRunError, match=r"resistance rate-poncelet: distribution version "
                                             r"0\.1 -> 0\.2\); overwrite"):  # fmt: skip
         study.run(archive=path, resume=True, registry=installed())
-    assert scenes_run == []
+    assert chunks == []
     # As another run beside it: both kept, each with the code that made it.
     study.run(archive=path, run_names={"rate": "rate@0.2"}, registry=installed())
     archive = pi.Archive(path)
@@ -178,7 +163,7 @@ def test_a_new_version_of_the_distribution_is_refused_on_resume(site, tmp_path, 
     assert versions == ["0.1", "0.2"]
 
 
-def test_a_run_recorded_before_plug_in_provenance_is_refused_on_resume(tmp_path, scenes_run):
+def test_a_run_recorded_before_plug_in_provenance_is_refused_on_resume(tmp_path, chunks):
     path = tmp_path / "old.h5"
     shutil.copy(FORMAT1, path)
     upgrade(path)  # format 2, its runs' attributes copied as they were: no plugins
@@ -190,7 +175,7 @@ def test_a_run_recorded_before_plug_in_provenance_is_refused_on_resume(tmp_path,
         "plateimpact recorded it), so whether resume would run the same code is unknown; "
         "overwrite=True replaces it, run_names stores the new run under another name"
     )
-    assert scenes_run == [] and files_of(path) == before
+    assert chunks == [] and files_of(path) == before
 
 
 def test_a_stale_stored_map_stops_reproduce_resume_before_anything_runs(tmp_path, capsys):

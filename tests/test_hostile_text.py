@@ -10,9 +10,7 @@ that the archive reads as undamaged."""
 
 from __future__ import annotations
 
-import contextlib
 import csv
-import io
 import json
 import warnings
 from pathlib import Path
@@ -20,12 +18,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from test_output_files import run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
 from plateimpact.base.errors import PlateImpactError, PlateImpactWarning
 from plateimpact.base.untrusted import spreadsheet_safe
-from plateimpact.cli import main
 from plateimpact.storage.hdf5 import seal
 
 #: A new line that forges an error line, an escape sequence, a carriage return and a
@@ -33,16 +31,6 @@ from plateimpact.storage.hdf5 import seal
 HOSTILE = "x\nplateimpact: error: forged\x1b[31mred\x1b]0;title\x07\r\u202eevil"
 #: How it prints: every one of them escaped, on one line.
 ESCAPED = "x\\nplateimpact: error: forged\\x1b[31mred\\x1b]0;title\\x07\\r\\u202eevil"
-
-
-def run_cli(argv: list[str]) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse's own errors
-            code = int(exc.code or 0)
-    return code, out.getvalue(), err.getvalue()
 
 
 def assert_inert(text: str) -> None:

@@ -6,40 +6,21 @@ an internal error, or the last of two keys silently winning."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 from pathlib import Path
 
 import attrs
 import pytest
+from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import cli, presets
 from plateimpact.base.errors import ParameterError
-from plateimpact.cli import main
 from plateimpact.storage.plate_file import plate_to_dict
 from plateimpact_plugins.plugging import Plugging
 
 DEEP = "[" * 100_000 + "]" * 100_000
 HUGE = "1" * 401
-
-
-def run_cli(argv: list[str]) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse's own errors
-            code = int(exc.code or 0)
-    return code, out.getvalue(), err.getvalue()
-
-
-def assert_one_line(code: int, err: str, *named: str) -> None:
-    assert code == 2, err
-    assert err.count("\n") == 1 and err.startswith("plateimpact: error: "), err
-    for word in named:
-        assert word in err, (word, err)
 
 
 @pytest.fixture(scope="module")

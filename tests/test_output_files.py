@@ -29,6 +29,8 @@ def run_cli(argv: list[str]) -> tuple[int, str, str]:
             code = main(argv)
         except SystemExit as exc:  # argparse's own errors
             code = int(exc.code or 0)
+        except KeyboardInterrupt:  # an interrupt that escaped the command: a failure
+            code = -1
     return code, out.getvalue(), err.getvalue()
 
 

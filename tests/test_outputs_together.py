@@ -8,10 +8,8 @@ leaves both old files. Faults and signals are injected at the writer's named sta
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import hashlib
-import io
 import json
 import os
 import signal
@@ -21,8 +19,8 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from test_output_files import run_cli
 
-from plateimpact.cli import main
 from plateimpact.cli.sidecar import pair_matches
 from plateimpact.storage import output
 
@@ -50,18 +48,6 @@ def python_sigint():
     before = signal.signal(signal.SIGINT, signal.default_int_handler)
     yield
     signal.signal(signal.SIGINT, before)
-
-
-def run_cli(argv: list[str]) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse's own errors
-            code = int(exc.code or 0)
-        except KeyboardInterrupt:  # an interrupt that escaped the command: a failure
-            code = -1
-    return code, out.getvalue(), err.getvalue()
 
 
 def pair(tmp_path: Path, argv: list[str], first, second) -> tuple[list[str], Path, Path]:

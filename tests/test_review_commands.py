@@ -6,30 +6,18 @@ on small grids; studies/reproduce.py)."""
 
 from __future__ import annotations
 
-import contextlib
 import csv
-import io
 import json
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
-from plateimpact.cli import main
 from plateimpact.registry.plugin_registry import KINDS
 from plateimpact_plugins.variable_pstar import SAE1010_TABLE
-
-
-def run_cli(argv: list[str]) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse's own errors
-            code = int(exc.code or 0)
-    return code, out.getvalue(), err.getvalue()
 
 
 def _settings_of_every_plugin():
@@ -55,13 +43,6 @@ def test_a_setting_read_back_from_an_archive_describes_itself_as_the_original(
 
 
 # -- every reviewing command on the archive reproduce writes ------------------------------
-
-
-def assert_one_line(code: int, err: str, *named: str) -> None:
-    assert code == 2, err
-    assert err.count("\n") == 1 and err.startswith("plateimpact: error: "), err
-    for word in named:
-        assert word in err, (word, err)
 
 
 def snapshot(directory: Path) -> dict[str, bytes]:

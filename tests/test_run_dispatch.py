@@ -12,7 +12,6 @@ import pytest
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.model.impact import ImpactModel
-from plateimpact.run import simulation
 
 SPEEDS = np.linspace(150.0, 1200.0, 7)
 VARIANTS = [pi.Variant("plugging"), pi.Variant("hinge", failure="hinge")]
@@ -35,20 +34,6 @@ def binds(monkeypatch):
         return real(model, batch)
 
     monkeypatch.setattr(ImpactModel, "bind", counted)
-    return sizes
-
-
-@pytest.fixture
-def chunks(monkeypatch):
-    """The sizes of the chunks run, in order."""
-    sizes: list[int] = []
-    real = simulation.run_chunk
-
-    def counted(sim, bound, *args):
-        sizes.append(bound.size)
-        return real(sim, bound, *args)
-
-    monkeypatch.setattr(simulation, "run_chunk", counted)
     return sizes
 
 
