@@ -52,13 +52,17 @@ def sha256_of_modules(modules: dict[str, Path]) -> str:
 
 
 def isotropic_sha256(site: Path) -> str:
-    """The rate law's source hash, from the rule: its module (the package's __init__) and
-    what it imports from the built-ins' package by name, plateimpact_plugins, whose
-    __init__ imports every built-in module."""
-    modules = {PACKAGE: site / PACKAGE / "__init__.py"}
-    for path in BUILTINS.glob("*.py"):
-        stem = "" if path.stem == "__init__" else f".{path.stem}"
-        modules[f"plateimpact_plugins{stem}"] = path
+    """The rate law's source hash, from the rule: its module (the package's __init__),
+    what it imports from the built-ins' package by name, plateimpact_plugins.report, and
+    what that imports (its constants, the failure plane, the P* table), with the enclosing
+    package's __init__ (not followed: the built-in plug-ins themselves)."""
+    modules = {
+        PACKAGE: site / PACKAGE / "__init__.py",
+        "plateimpact_plugins": BUILTINS / "__init__.py",
+        "plateimpact_plugins.report": BUILTINS / "report" / "__init__.py",
+    }
+    for stem in ("constants", "plane", "pstar_table"):
+        modules[f"plateimpact_plugins.report.{stem}"] = BUILTINS / "report" / f"{stem}.py"
     return sha256_of_modules(modules)
 
 
@@ -220,7 +224,8 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
         files = {m: Path(importlib.util.find_spec(m).origin) for m in entry["source_modules"]}
         assert entry["source_sha256"] == sha256_of_modules(files)
     assert record["failure"]["source_modules"] == [
-        "plateimpact_plugins", "plateimpact_plugins.hinge", "plateimpact_plugins.plate_constants",
+        "plateimpact_plugins", "plateimpact_plugins.hinge", "plateimpact_plugins.report",
+        "plateimpact_plugins.report.constants", "plateimpact_plugins.report.plane",
         "plateimpact_plugins.separation",
     ]  # fmt: skip
     assert record["integrator"]["class"] == "plateimpact_plugins.segment.Segment"

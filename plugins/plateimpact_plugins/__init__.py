@@ -1,7 +1,10 @@
 """The built-in plug-ins of plateimpact.
 
 This package uses only plateimpact's public API and registers through the
-``plateimpact`` entry-point group, exactly as a third-party plug-in package does.
+``plateimpact`` entry-point group, exactly as a third-party plug-in package does. The
+report's vocabulary that other plug-ins share (plate constants, the failure plane, the
+variable-P* table) is the public module :mod:`plateimpact_plugins.report`; the names
+re-exported here from it stay for the plug-ins written before it.
 """
 
 from __future__ import annotations
@@ -12,13 +15,14 @@ from .dopri5 import DormandPrince54
 from .embedded_rk import EmbeddedRungeKutta
 from .hinge import Hinge
 from .intact import Intact
-from .plate_constants import CRITICAL_PENETRATION, DENSITY_B, FAILURE_ANGLE, STRENGTH_A
 from .plugging import Plugging
 from .poncelet import Poncelet
+from .report import CRITICAL_PENETRATION, DENSITY_B, FAILURE_ANGLE, STRENGTH_A
+from .report.pstar_table import SAE1010_TABLE, PstarTable
 from .scipy_ivp import ScipyIVP
 from .segment import Segment
 from .separation import PlaneSeparation
-from .variable_pstar import SAE1010_TABLE, PstarTable, VariablePstar
+from .variable_pstar import VariablePstar
 
 __all__ = [
     "CRITICAL_PENETRATION",

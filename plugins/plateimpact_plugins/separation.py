@@ -9,7 +9,8 @@ import numpy as np
 
 from plateimpact import BoundResistance, Column, FailureModel, Parameter, SceneBatch, geometry
 
-from .plate_constants import FAILURE_ANGLE
+from .report.constants import FAILURE_ANGLE
+from .report.plane import failure_plane_depth
 
 
 class PlaneSeparation(FailureModel):
@@ -40,8 +41,9 @@ class PlaneSeparation(FailureModel):
 
     def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
         onset = self.onset_penetration(batch)
-        ring_depth = batch.radius * np.cos(batch.failure_angle) + onset - batch.radius  # eq 8
-        return {"failure_plane_depth": np.maximum(ring_depth, 0.0)}
+        return {
+            "failure_plane_depth": failure_plane_depth(batch.radius, batch.failure_angle, onset)
+        }
 
     def relief(
         self,

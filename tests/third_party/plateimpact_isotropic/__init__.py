@@ -20,7 +20,7 @@ import attrs
 import numpy as np
 
 from plateimpact import Parameter, PluginRegistry, Range, ResistanceLaw, SceneBatch, hookimpl
-from plateimpact_plugins import DENSITY_B, STRENGTH_A
+from plateimpact_plugins.report import DENSITY_B, STRENGTH_A
 
 RATE_SENSITIVITY = Parameter(
     "rate_sensitivity",
