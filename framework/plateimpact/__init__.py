@@ -129,7 +129,7 @@ _SUBMODULES: dict[str, str] = {
     "experiment": "experiment",
     "geometry": "model.geometry",
     "limits": "limits",
-    "presets": "model.presets",
+    "presets": "registry.presets",
     "units": "units",
     "v50": "v50",
 }
@@ -197,7 +197,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .comparison import Comparison
     from .experiment import ValidationReport, validate
     from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots
-    from .model import batch, geometry, presets
+    from .model import batch, geometry
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
     from .model.failure import FailureModel
@@ -222,6 +222,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .model.resistance import BoundResistance, ResistanceLaw, contact_force
     from .model.results import BatchResult, CraterSection, Outcome, Result, Trajectory
     from .model.scene import Scene
+    from .registry import presets
     from .registry.discovery import BrokenPackage
     from .registry.hookspecs import hookimpl
     from .registry.plugin_registry import PluginRegistry, default_registry, load_registry

@@ -18,6 +18,7 @@ from .intact import Intact
 from .plugging import Plugging
 from .poncelet import Poncelet
 from .report import CRITICAL_PENETRATION, DENSITY_B, FAILURE_ANGLE, STRENGTH_A
+from .report.presets import register_presets
 from .report.pstar_table import SAE1010_TABLE, PstarTable
 from .scipy_ivp import ScipyIVP
 from .segment import Segment
@@ -47,15 +48,10 @@ __all__ = [
 
 @hookimpl
 def plateimpact_register(registry: PluginRegistry) -> None:
-    """Register the built-in resistance law, failure models and integrators."""
-    for cls in (
-        Poncelet,
-        Plugging,
-        Hinge,
-        VariablePstar,
-        Intact,
-        Segment,
-        DormandPrince54,
-        ScipyIVP,
-    ):
-        registry.add(cls)
+    """Register the built-in resistance law, failure models and integrators, the
+    report's model as the default of each kind, and Table 1's plates and sphere."""
+    for cls in (Poncelet, Plugging, DormandPrince54):  # the report's model
+        registry.add(cls, default=True)
+    for other in (Hinge, VariablePstar, Intact, Segment, ScipyIVP):
+        registry.add(other)
+    register_presets(registry)

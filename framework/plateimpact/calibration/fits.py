@@ -11,7 +11,7 @@ from scipy.optimize import least_squares
 
 from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
 from ..model.bodies import Plate, Sphere
-from ..model.presets import DEFAULT_SPHERE
+from ..registry.plugin_registry import default_registry
 from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
@@ -108,7 +108,7 @@ def newton_fit(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere = DEFAULT_SPHERE,
+    sphere: Sphere | None = None,
     simulation: Simulation | None = None,
     start: tuple[float, float] | None = None,
     tolerance: float = NEWTON_TOLERANCE,
@@ -128,6 +128,7 @@ def newton_fit(
     :class:`ConvergenceError` after ``max_iterations`` steps.
     """
     simulation = simulation or Simulation.from_names()
+    sphere = sphere or default_registry().sphere
     normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds = normal.impact_speed
@@ -214,7 +215,7 @@ def direct_fit(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere = DEFAULT_SPHERE,
+    sphere: Sphere | None = None,
     simulation: Simulation | None = None,
     start: tuple[float, float] | None = None,
     step: float = DIFFERENCE_STEP,
@@ -233,6 +234,7 @@ def direct_fit(
     one (those the data or the model perforates).
     """
     simulation = simulation or Simulation.from_names()
+    sphere = sphere or default_registry().sphere
     normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds, measured = normal.impact_speed, normal.residual_speed
@@ -334,7 +336,7 @@ def calibrate(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere = DEFAULT_SPHERE,
+    sphere: Sphere | None = None,
     simulation: Simulation | None = None,
     max_scenes: int | None = MAX_FIT_SCENES,
 ) -> CalibrationReport:
@@ -343,6 +345,7 @@ def calibrate(
     run more than ``max_scenes`` scenes (AB_SCENES_PER_SHOT per normal-incidence shot;
     None: no bound)."""
     simulation = simulation or Simulation.from_names()
+    sphere = sphere or default_registry().sphere
     normal = normal_shots(shots)
     scenes = len(normal) * AB_SCENES_PER_SHOT
     if max_scenes is not None and scenes > max_scenes:

@@ -16,7 +16,7 @@ import numpy as np
 from ..base.errors import CalibrationError, ConvergenceError
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
-from ..model.presets import DEFAULT_SPHERE
+from ..registry.plugin_registry import default_registry
 from ..run.simulation import Simulation
 from ..storage.shots import Shots
 from .model_lines import Cost, LineModel, check_finder
@@ -126,7 +126,7 @@ def fit_pstar(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere = DEFAULT_SPHERE,
+    sphere: Sphere | None = None,
     simulation: Simulation | None = None,
     model: ProbabilityModel | None = None,
     fit_alpha: bool = False,
@@ -146,6 +146,7 @@ def fit_pstar(
     :class:`ConvergenceError` when the search does not converge.
     """
     simulation = simulation or Simulation.from_names()
+    sphere = sphere or default_registry().sphere
     model = model or ProbabilityModel()
     _check_model(simulation, fit_alpha)
     check_finder(resolution, tolerance)
@@ -229,7 +230,7 @@ def fit_pstar_by_obliquity(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere = DEFAULT_SPHERE,
+    sphere: Sphere | None = None,
     simulation: Simulation | None = None,
     model: ProbabilityModel | None = None,
     resolution: float = SPEED_RESOLUTION,
@@ -247,6 +248,7 @@ def fit_pstar_by_obliquity(
     :class:`~plateimpact.base.errors.WorkBoundError`; an obliquity whose likelihoods turn out
     to fix neither raises :class:`CalibrationError` after the fit, all of them at once."""
     simulation = simulation or Simulation.from_names()
+    sphere = sphere or default_registry().sphere
     model = model or ProbabilityModel()
     _check_model(simulation, False)
     check_finder(resolution, tolerance)

@@ -9,7 +9,6 @@ import json
 from typing import Any
 
 from ..base.parameters import Parameter
-from ..model import presets
 from ..model.bodies import MASS, RADIUS, THICKNESS
 from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
 from .common import say
@@ -38,17 +37,17 @@ def presets_command(args: argparse.Namespace) -> None:
     registry = default_registry()
     declared = {THICKNESS.name: THICKNESS, **registry.plate_constants}
     rows: dict[str, dict[str, Any]] = {}
-    for name, plate in presets.PLATES.items():
+    for name, plate in registry.plates.items():
         row: dict[str, Any] = {"material": plate.material}
         for constant, value in [("thickness", plate.thickness), *plate.constants]:
             row[declared[constant].key] = _user_value(declared[constant], value)
         rows[name] = row
-    sphere = presets.DEFAULT_SPHERE
+    sphere = registry.sphere
     sphere_row = {
-        "material": "SAE 52100",
+        "material": registry.sphere_material,
         RADIUS.key: _user_value(RADIUS, sphere.radius),
         MASS.key: _user_value(MASS, sphere.mass),
-        "density_kg_m3": presets.SAE_52100_DENSITY,
+        "density_kg_m3": registry.sphere_density,
     }
     if args.json:
         say(json.dumps({"plates": rows, "sphere": sphere_row}, indent=2))
@@ -59,8 +58,8 @@ def presets_command(args: argparse.Namespace) -> None:
         values = " ".join(f"{row[k]:12.4g}" for k in keys)
         say(f"{name:14s} {row['material']:9s} {values}")
     say(
-        f"\nsphere (default): SAE 52100, radius {sphere.radius * 1e3:.4g} mm, "
-        f"mass {sphere.mass * 1e3:.4f} g, density {presets.SAE_52100_DENSITY:.0f} kg/m^3"
+        f"\nsphere (default): {registry.sphere_material}, radius {sphere.radius * 1e3:.4g} mm, "
+        f"mass {sphere.mass * 1e3:.4f} g, density {registry.sphere_density:.0f} kg/m^3"
     )
 
 
