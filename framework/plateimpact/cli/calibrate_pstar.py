@@ -7,33 +7,40 @@ import argparse
 import json
 import math
 import os
-from typing import Any
+from typing import Any, TypeAlias
 
 from ..base.units import g, mm
-from ..calibration.model_lines import Cost, check_finder
-from ..calibration.outcome_model import (
+from ..calibration import (
+    MAX_FIT_SCENES,
     OUTCOME_BLUNDER,
     RESIDUAL_SIGMA_BOUNDS,
     SPEED_SIGMA,
+    Cost,
     ProbabilityModel,
+    check_finder,
 )
-from ..calibration.pstar import (
-    PstarFit,
-    PstarTableFit,
-    fit_pstar,
-    fit_pstar_by_obliquity,
-)
-from ..calibration.pstar_plan import MAX_FIT_SCENES
-from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, PstarEstimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
 from ..provenance.metadata import versions
+from ..registry.plugin_registry import default_registry
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.shots import Shots
 from .common import UsageError, check_directory, say, write_atomically
 from .options import bodies, model_choice, typed
+
+#: The fits, and their search's constants, are the registered calibration procedure's (a
+#: plug-in package's): PstarFit, PstarTableFit and PstarEstimate are its classes.
+PstarFit: TypeAlias = Any
+PstarTableFit: TypeAlias = Any
+PstarEstimate: TypeAlias = Any
+
+
+def _fits() -> Any:
+    """The registered calibration procedure (the report's, from its plug-in package)."""
+    return default_registry().procedure("calibration")
+
 
 #: The options only --fit pstar reads, with their defaults (a typed one is refused with
 #: --fit ab rather than ignored).
@@ -136,13 +143,13 @@ def pstar_command(args: argparse.Namespace) -> None:
     bound = None if args.force else MAX_FIT_SCENES
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
-            table = fit_pstar_by_obliquity(
+            table = _fits().fit_pstar_by_obliquity(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
                 resolution=finder["resolution"], tolerance=finder["tolerance"],
                 max_scenes=bound,
             )  # fmt: skip
         else:
-            fit = fit_pstar(
+            fit = _fits().fit_pstar(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
                 fit_alpha=args.alpha_fit, resolution=finder["resolution"],
                 tolerance=finder["tolerance"], max_scenes=bound,
@@ -182,9 +189,9 @@ def _probability_model(
 
 def _search(finder: dict[str, float], cost: Cost, sphere_radius: float) -> dict[str, Any]:
     return {
-        "pstar_range_mm": [r * sphere_radius / mm for r in PSTAR_RANGE],
-        "scan_points": SCAN_POINTS,
-        "information_step_ln_pstar": PSTAR_STEP,
+        "pstar_range_mm": [r * sphere_radius / mm for r in _fits().PSTAR_RANGE],
+        "scan_points": _fits().SCAN_POINTS,
+        "information_step_ln_pstar": _fits().PSTAR_STEP,
         "resolution_m_s": finder["resolution"],
         "tolerance_m_s": finder["tolerance"],
         "evaluations": cost.evaluations,
@@ -218,7 +225,7 @@ def _fit_summary(
         "log_likelihood": e.log_likelihood,
         "converged": True,  # a fit that does not converge is an error (exit code 2)
         "shots_near_boundary": e.near,
-        "near_boundary_speed_sigmas": NEAR,
+        "near_boundary_speed_sigmas": _fits().NEAR,
         "probability_model": _probability_model(args, fit.model, e.residual_sigma),
         "search": _search(finder, fit.cost, sphere.radius),
         "note": fit.note or None,
@@ -268,7 +275,7 @@ def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
         + (" (given)" if args.speed_sigma is not None else " (default)")
         + f", {sigma}, blunder {OUTCOME_BLUNDER:g}",
         f"P* = {e.pstar / mm:.5g} ± {e.pstar_stderr / mm:.2g} mm, {alpha}",
-        f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {NEAR:g} s of a "
+        f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {_fits().NEAR:g} s of a "
         f"boundary; {fit.cost.evaluations} candidates in {fit.cost.batches} batches, "
         f"{fit.cost.seconds:.1f} s",
     ]

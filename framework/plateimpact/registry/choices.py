@@ -1,5 +1,6 @@
 """What plug-in packages name besides their classes: the plug-in of each kind used when
-none is named, named plates (presets) and the default sphere.
+none is named, named plates (presets), the default sphere and procedures that commands
+run (``calibration``: what ``plateimpact calibrate`` fits).
 
 The core names none of them: a package declares them when it registers
 (``registry.add(cls, default=True)``, ``registry.add_plate(name, plate)``,
@@ -12,6 +13,7 @@ in one line (and, as an installed package, skipped).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 from ..base.errors import PluginError, UnknownNameError
@@ -26,12 +28,15 @@ class Choices:
         self._defaults: dict[str, tuple[str, str]] = {}  # kind -> (name, module)
         self._plates: dict[str, Plate] = {}  # preset name -> plate
         self._sphere: tuple[Sphere, float, str] | None = None  # sphere, density, material
+        self._procedures: dict[str, Callable[[], Any]] = {}  # name -> loader
+        self._loaded: dict[str, Any] = {}
 
     def _save_choices(self) -> tuple[Any, ...]:
-        return dict(self._defaults), dict(self._plates), self._sphere
+        return dict(self._defaults), dict(self._plates), self._sphere, dict(self._procedures)
 
     def _restore_choices(self, saved: tuple[Any, ...]) -> None:
         self._defaults, self._plates, self._sphere = dict(saved[0]), dict(saved[1]), saved[2]
+        self._procedures = dict(saved[3])
 
     def _claim_default(self, kind: str, name: str, module: str) -> None:
         known = self._defaults.get(kind)
@@ -115,3 +120,24 @@ class Choices:
                 "give the sphere (--radius and --mass)"
             )
         return self._sphere
+
+    def add_procedure(self, name: str, load: Callable[[], Any]) -> None:
+        """Register the procedure ``name`` (``"calibration"``): ``load()`` returns the object
+        that provides it (a module), called on first use so that registering costs no
+        import. PluginError if another package registered that name."""
+        if not (isinstance(name, str) and name) or not callable(load):
+            raise PluginError(f"a procedure needs a name and a loader, got {name!r:.60}")
+        known = self._procedures.get(name)
+        if known is not None and known is not load:
+            raise PluginError(f"procedure {name!r} is registered twice")
+        self._procedures[name] = load
+
+    def procedure(self, name: str) -> Any:
+        """The object providing the procedure ``name``; UnknownNameError if none does."""
+        if name not in self._loaded:
+            if name not in self._procedures:
+                raise UnknownNameError(
+                    f"no installed plug-in package provides the {name} procedure"
+                )
+            self._loaded[name] = self._procedures[name]()
+        return self._loaded[name]

@@ -9,22 +9,37 @@ import attrs
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
-from ..model.bodies import Plate, Sphere
-from ..registry.plugin_registry import default_registry
-from ..run.simulation import Simulation
-from ..storage.shots import Shots
-from .dri import MIN_PERFORATIONS, DriFit, fit_dri
-from .pstar_plan import MAX_FIT_SCENES
-from .start import (
+from plateimpact import (
+    CalibrationError,
+    ConvergenceError,
+    DriFit,
+    Plate,
+    Shots,
+    Simulation,
+    Sphere,
+    WorkBoundError,
+    calibration,
+    fit_dri,
+)
+
+from .ab_start import (
     check_start,
     energy_balance_start,
-    fit_model_dri,
     in_model_domain,
     log_domain,
     model_residual_speeds,
-    normal_shots,
 )
+from .presets import DEFAULT_SPHERE
+from .pstar_plan import MAX_FIT_SCENES
+
+MIN_PERFORATIONS = calibration.MIN_PERFORATIONS
+fit_model_dri = calibration.fit_model_dri
+
+
+def normal_shots(shots: Shots) -> Shots:
+    """The normal-incidence shots the fits of a and b take (three perforations at least)."""
+    return calibration.normal_shots(shots, "a and b")
+
 
 #: Relative step of a and b for the finite differences of eqs 44–47 (and the direct fit).
 DIFFERENCE_STEP = 1e-3
@@ -108,7 +123,7 @@ def newton_fit(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere | None = None,
+    sphere: Sphere = DEFAULT_SPHERE,
     simulation: Simulation | None = None,
     start: tuple[float, float] | None = None,
     tolerance: float = NEWTON_TOLERANCE,
@@ -128,7 +143,6 @@ def newton_fit(
     :class:`ConvergenceError` after ``max_iterations`` steps.
     """
     simulation = simulation or Simulation.from_names()
-    sphere = sphere or default_registry().sphere
     normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds = normal.impact_speed
@@ -215,7 +229,7 @@ def direct_fit(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere | None = None,
+    sphere: Sphere = DEFAULT_SPHERE,
     simulation: Simulation | None = None,
     start: tuple[float, float] | None = None,
     step: float = DIFFERENCE_STEP,
@@ -234,7 +248,6 @@ def direct_fit(
     one (those the data or the model perforates).
     """
     simulation = simulation or Simulation.from_names()
-    sphere = sphere or default_registry().sphere
     normal = normal_shots(shots)
     target = fit_dri(normal.impact_speed, normal.residual_speed)
     speeds, measured = normal.impact_speed, normal.residual_speed
@@ -336,7 +349,7 @@ def calibrate(
     shots: Shots,
     plate: Plate,
     *,
-    sphere: Sphere | None = None,
+    sphere: Sphere = DEFAULT_SPHERE,
     simulation: Simulation | None = None,
     max_scenes: int | None = MAX_FIT_SCENES,
 ) -> CalibrationReport:
@@ -345,7 +358,6 @@ def calibrate(
     run more than ``max_scenes`` scenes (AB_SCENES_PER_SHOT per normal-incidence shot;
     None: no bound)."""
     simulation = simulation or Simulation.from_names()
-    sphere = sphere or default_registry().sphere
     normal = normal_shots(shots)
     scenes = len(normal) * AB_SCENES_PER_SHOT
     if max_scenes is not None and scenes > max_scenes:
