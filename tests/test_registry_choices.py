@@ -110,3 +110,14 @@ def test_a_table_setting_is_held_as_its_declared_json_form():
     assert numpy_settings.integrator_settings == {"rtol": 1e-9}
     with pytest.raises(pi.ParameterError, match="is not a JSON value"):
         pi.Variant("x", integrator_settings={"rtol": object()})
+
+
+def test_the_moved_calibration_names_still_work_deprecated_through_the_registry():
+    from plateimpact_plugins.report import fits  # noqa: PLC0415
+
+    for name in ("calibrate", "newton_fit", "fit_pstar", "PstarTableFit"):
+        with pytest.warns(DeprecationWarning, match=f"plateimpact.{name} is deprecated: import"):
+            assert getattr(pi, name) is getattr(fits, name)
+    assert BUILTINS.procedure("calibration") is fits
+    with pytest.raises(pi.UnknownNameError, match="no installed plug-in package provides"):
+        pi.load_registry(entry_points=False).procedure("calibration")
