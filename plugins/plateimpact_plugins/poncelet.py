@@ -24,6 +24,6 @@ class Poncelet(ResistanceLaw):
     name = "poncelet"
     plate_constants = (STRENGTH_A, DENSITY_B)
 
-    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
         normal_speed = speed * np.cos(incidence)
-        return batch.a + batch.b * normal_speed * normal_speed
+        return scenes.a + scenes.b * normal_speed * normal_speed

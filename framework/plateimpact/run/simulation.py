@@ -13,7 +13,7 @@ from ..base.errors import ParameterError, PluginError
 from ..model.batch import SceneBatch, check_chunk_size
 from ..model.binding import BoundBatch
 from ..model.crater import crater_sections
-from ..model.impact import REST_SPEED_FRACTION, ImpactModel
+from ..model.impact import REST_SPEED_FRACTION, ImpactModel, describe_plugin
 from ..model.results import BatchResult, Result
 from ..model.scene import Scene
 from ..registry.plugin_registry import PluginRegistry, default_registry
@@ -118,13 +118,9 @@ class Simulation:
         return self.run_batch([scene], record_trajectory=record_trajectory).result(0)
 
     def describe(self) -> dict[str, object]:
-        """Plug-in names, versions and settings."""
-        return {
-            **self.model.describe(),
-            "integrator": self.integrator.name,
-            "integrator_version": self.integrator.version,
-            "integrator_settings": self.integrator.settings(),
-        }
+        """Each slot's plug-in name, version and settings (the model's, then the
+        integrator's), and the rest rule."""
+        return {**self.model.describe(), **describe_plugin("integrator", self.integrator)}
 
 
 def _settings(kind: str, settings: object) -> dict[str, Any]:
