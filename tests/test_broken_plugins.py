@@ -170,7 +170,7 @@ def test_an_unknown_name_mentions_the_packages_that_failed(installed, capsys):
     assert main([*RUN, "--failure", "shatter"]) == 2
     last = capsys.readouterr().err.splitlines()[-1]
     assert last.endswith(
-        f"unknown failure 'shatter'; choose from: hinge, intact, plugging, variable-pstar "
+        f"unknown failure 'shatter'; choose from: brittle, hinge, intact, plugging, variable-pstar "
         f"(1 plug-in package failed to load: {distribution})"
     )
 

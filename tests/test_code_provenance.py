@@ -38,7 +38,7 @@ VARIANT = pi.Variant(
     "rate", resistance="rate-poncelet", resistance_settings={"reference_speed": 50.0}
 )
 #: The line of the rate law that the "new release" changes (and so its results).
-LAW = "strength = batch.a * (1.0 + batch.rate_sensitivity * rate)"
+LAW = "strength = scenes.a * (1.0 + scenes.rate_sensitivity * rate)"
 
 
 def sha256_of_modules(modules: dict[str, Path]) -> str:
@@ -52,10 +52,14 @@ def sha256_of_modules(modules: dict[str, Path]) -> str:
 
 
 def isotropic_sha256(site: Path) -> str:
-    """The rate law's source hash, from the rule: its module (the package's __init__) and
-    what it imports from the built-ins' package by name, plateimpact_plugins, whose
-    __init__ imports every built-in module."""
+    """The rate law's source hash, from the rule: its module (the package's __init__), the
+    package's modules that imports (its failure model and integrator), and what it imports
+    from the built-ins' package by name, plateimpact_plugins, whose __init__ imports every
+    built-in module."""
     modules = {PACKAGE: site / PACKAGE / "__init__.py"}
+    for path in (site / PACKAGE).glob("*.py"):
+        if path.stem != "__init__":
+            modules[f"{PACKAGE}.{path.stem}"] = path
     for path in BUILTINS.glob("*.py"):
         stem = "" if path.stem == "__init__" else f".{path.stem}"
         modules[f"plateimpact_plugins{stem}"] = path
