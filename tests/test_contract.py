@@ -159,3 +159,20 @@ def test_the_driver_reuses_the_known_rates_and_nothing_else_changes(monkeypatch)
 def test_prepare_belongs_to_every_plug_in():
     assert pi.Plugin.prepare is pi.ResistanceLaw.prepare is pi.FailureModel.prepare
     assert pi.Integrator.prepare is pi.Plugin.prepare
+
+
+def test_the_built_in_laws_formula_is_one_function_of_numbers_or_arrays():
+    # What a compiled path compiles is the function the numpy path calls: per scene on
+    # numbers it gives, bit for bit, what the law gives on the arrays.
+    from plateimpact_plugins.poncelet import poncelet_stress
+
+    rng = np.random.default_rng(3)
+    speed, incidence = rng.uniform(0, 2000, 50), rng.uniform(-1.5, 1.5, 50)
+    scenes = pi.SceneBatch.of({"a": rng.uniform(1e8, 1e9, 50), "b": rng.uniform(1e2, 1e4, 50)}, 50)
+    law = pi.load_registry().create("resistance", "poncelet")
+    on_arrays = law.stress(speed, incidence, scenes)
+    one_by_one = [
+        poncelet_stress(float(v), float(psi), float(a), float(b))
+        for v, psi, a, b in zip(speed, incidence, scenes.a, scenes.b, strict=True)
+    ]
+    np.testing.assert_array_equal(on_arrays, one_by_one)
