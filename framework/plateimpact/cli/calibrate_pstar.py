@@ -123,7 +123,7 @@ def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Write
                 "--fit pstar holds a and b fixed: give --preset, --plate-file, or --a and --b "
                 "(fit them first with --fit ab)"
             )
-        choice.plate.setdefault("critical_penetration", 1e-3)  # what the fit finds
+        choice.plate.setdefault("critical_penetration", mm)  # what the fit finds
     sphere, given_plate, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given_plate.thickness, given_plate.constants)
     typed(args).update({"speed_sigma": "--speed-sigma", "residual_sigma": "--residual-sigma"})
