@@ -170,7 +170,9 @@ def test_a_new_version_of_the_distribution_is_refused_on_resume(site, tmp_path, 
 def test_a_run_recorded_before_plug_in_provenance_is_refused_on_resume(tmp_path, chunks):
     path = tmp_path / "old.h5"
     shutil.copy(FORMAT1, path)
-    upgrade(path)  # format 2, its runs' attributes copied as they were: no plugins
+    upgrade(
+        path, registry=pi.default_registry()
+    )  # format 2, its runs' attributes copied as they were: no plugins
     before = files_of(path)
     with pytest.raises(StaleRunError) as refused:
         pi.Study.from_archive(path).run(archive=path, resume=True)
@@ -366,7 +368,7 @@ def test_experiment_outputs_are_kept_only_while_their_recorded_code_is_current(
 def test_a_plain_run_computes_no_record(monkeypatch, capsys):
     """``run`` without ``--json`` prints no provenance, so it computes none (no hash, no
     git): it costs what it did before the code was recorded."""
-    from plateimpact.cli import scene_commands  # noqa: PLC0415
+    from plateimpact.cli.commands import run as scene_commands  # noqa: PLC0415
 
     asked = []
     monkeypatch.setattr(scene_commands, "inputs_record", lambda *a, **k: asked.append(a) or {})

@@ -28,12 +28,15 @@ from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINT
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
 from ..provenance.metadata import versions
+from ..registry.plugin_registry import PluginRegistry
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.shots import Shots
-from .common import UsageError, check_directory, say, write_atomically
+from .common import UsageError, check_directory, write_atomically
+from .formatting import ANGLE, user
 from .options import bodies, model_choice, typed
+from .writer import Writer
 
 #: The options only --fit pstar reads, with their defaults (a typed one is refused with
 #: --fit ab rather than ignored).
@@ -93,7 +96,7 @@ def refuse_pstar_options(args: argparse.Namespace) -> None:
             raise UsageError(f"{flag}: only with --fit pstar")
 
 
-def pstar_command(args: argparse.Namespace) -> None:
+def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> None:
     """Run ``plateimpact calibrate --fit pstar``."""
     for flag in ("--method", "--png"):
         if getattr(args, flag.lstrip("-")) is not None:
@@ -105,7 +108,7 @@ def pstar_command(args: argparse.Namespace) -> None:
         )
     check_directory(args.out, "--out")
     shots = Shots.from_csv(args.shots)
-    choice = model_choice(args)
+    choice = model_choice(args, registry)
     simulation = choice.simulation()
     if getattr(args, "pstar", None) is not None or "critical_penetration" in choice.plate:
         flag = choice.plate_flags.get("critical_penetration", "--pstar")
@@ -120,7 +123,7 @@ def pstar_command(args: argparse.Namespace) -> None:
                 "--fit pstar holds a and b fixed: give --preset, --plate-file, or --a and --b "
                 "(fit them first with --fit ab)"
             )
-        choice.plate.setdefault("critical_penetration", 1e-3)  # what the fit finds
+        choice.plate.setdefault("critical_penetration", mm)  # what the fit finds
     sphere, given_plate, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given_plate.thickness, given_plate.constants)
     typed(args).update({"speed_sigma": "--speed-sigma", "residual_sigma": "--residual-sigma"})
@@ -151,13 +154,13 @@ def pstar_command(args: argparse.Namespace) -> None:
         summary = _table_summary(args, table, simulation, finder, sphere)
         if args.out is not None:
             write_atomically(args.out, table.csv_text(), "--out")
-        say(json.dumps(summary) if args.json else _table_text(args, table))
+        out.say(json.dumps(summary) if args.json else _table_text(args, table))
         return
     summary = _fit_summary(args, fit, simulation, finder, sphere)
     if args.out is not None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
-        write_atomically(args.out, plate_file_text(fit.plate, extra), "--out")
-    say(json.dumps(summary) if args.json else _fit_text(args, fit))
+        write_atomically(args.out, plate_file_text(fit.plate, extra, registry=registry), "--out")
+    out.say(json.dumps(summary) if args.json else _fit_text(args, fit))
 
 
 def _finite(x: float) -> float | None:
@@ -208,11 +211,11 @@ def _fit_summary(
         "residual_speed_shots": fit.residual_shots,
         "pstar_mm": e.pstar / mm,
         "pstar_mm_stderr": e.pstar_stderr / mm,
-        "alpha_deg": math.degrees(e.alpha),
+        "alpha_deg": user(ANGLE, e.alpha),
         "alpha_fitted": fit.alpha_fitted,
     }
     if fit.alpha_fitted:
-        out["alpha_deg_stderr"] = math.degrees(e.alpha_stderr)
+        out["alpha_deg_stderr"] = user(ANGLE, e.alpha_stderr)
         out["pstar_alpha_correlation"] = e.correlation
     return out | {
         "log_likelihood": e.log_likelihood,
@@ -257,10 +260,10 @@ def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
     else:
         sigma = f"sigma_r = {e.residual_sigma:.3g} m/s (fitted)"
     alpha = (
-        f"alpha* = {math.degrees(e.alpha):.4g} ± {math.degrees(e.alpha_stderr):.2g} deg "
+        f"alpha* = {user(ANGLE, e.alpha):.4g} ± {user(ANGLE, e.alpha_stderr):.2g} deg "
         f"(correlation with P* {e.correlation:+.2f})"
         if fit.alpha_fitted
-        else f"alpha* = {math.degrees(e.alpha):.4g} deg (given)"
+        else f"alpha* = {user(ANGLE, e.alpha):.4g} deg (given)"
     )
     lines = [
         f"shots: {args.shots}: {fit.shots} used, {fit.residual_shots} with a residual speed",
@@ -299,7 +302,7 @@ def _table_summary(
 ) -> dict[str, Any]:
     rows = [
         {
-            "obliquity_deg": float(f"{math.degrees(row.obliquity):.12g}"),  # 60, not 59.99..
+            "obliquity_deg": float(f"{user(ANGLE, row.obliquity):.12g}"),  # 60, not 59.99..
             **_estimate_json("ricochet", row.ricochet, row.ricochet_shots),
             **_estimate_json("perforation", row.perforation, row.perforation_shots),
             "transition_start_m_s": row.transition_start,
@@ -312,7 +315,7 @@ def _table_summary(
         "fit": "pstar",
         "by_obliquity": True,
         "shots_file": args.shots,
-        "alpha_deg": math.degrees(table.alpha),
+        "alpha_deg": user(ANGLE, table.alpha),
         "rows": rows,
         "probability_model": _probability_model(args, table.model, math.nan)
         | {"residual_sigma_m_s": None},
@@ -329,14 +332,14 @@ def _table_text(args: argparse.Namespace, table: PstarTableFit) -> str:
         return f"{e.pstar / mm:.4g} ± {e.pstar_stderr / mm:.2g}"
 
     lines = [
-        f"P* by obliquity from {args.shots} (alpha* = {math.degrees(table.alpha):.4g} deg, "
+        f"P* by obliquity from {args.shots} (alpha* = {user(ANGLE, table.alpha):.4g} deg, "
         f"impact-speed scatter s = {table.model.speed_sigma:g} m/s)",
         f"{'obliquity':>9s}  {'ricochet P* [mm]':>22s}{'shots':>6s}  "
         f"{'perforation P* [mm]':>22s}{'shots':>6s}  band [m/s]",
     ]
     notes = []
     for row in table.rows:
-        degrees = f"{math.degrees(row.obliquity):.6g}"
+        degrees = f"{user(ANGLE, row.obliquity):.6g}"
         lines.append(
             f"{degrees:>9s}  {value(row.ricochet):>22s}{row.ricochet_shots:6d}  "
             f"{value(row.perforation):>22s}{row.perforation_shots:6d}  "

@@ -36,16 +36,30 @@ def _integrator(instance: object, attribute: attrs.Attribute, value: object) -> 
         raise PluginError(f"integrator must be an Integrator, got {value!r}")
 
 
+def _registry(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    if not isinstance(value, PluginRegistry):
+        raise ParameterError("registry", f"registry must be a PluginRegistry, got {value!r:.80}")
+
+
 @attrs.frozen
 class Simulation:
     """Runs scenes through one resolved model and integrator.
 
     Build it from plug-in names with :meth:`from_names`, then call :meth:`run` for one
     scene or :meth:`run_batch` for many; the CLI does exactly this.
+
+    ``registry`` is where the plug-ins were found; what reads or writes a plate, a run's
+    inputs or stored limits for this simulation takes its declarations from there. A
+    Simulation is where the library resolves an omitted registry: without one, the
+    installed plug-ins (:func:`~plateimpact.default_registry`; docs/plugins.md, "Where
+    the registry comes from").
     """
 
     model: ImpactModel
     integrator: Integrator = attrs.field(validator=_integrator)
+    registry: PluginRegistry = attrs.field(
+        factory=default_registry, kw_only=True, eq=False, repr=False, validator=_registry
+    )
 
     @classmethod
     def from_names(
@@ -61,7 +75,7 @@ class Simulation:
         registry: PluginRegistry | None = None,
     ) -> Simulation:
         """Resolve each slot by name from ``registry`` (default: installed plug-ins)."""
-        registry = registry or default_registry()
+        registry = default_registry() if registry is None else registry
         if not isinstance(registry, PluginRegistry):
             raise ParameterError("registry", f"registry must be a PluginRegistry, got {registry!r}")
         for slot, given in [
@@ -79,7 +93,7 @@ class Simulation:
             rest_speed_fraction=rest_speed_fraction,
         )
         settings = _settings("integrator", integrator_settings)
-        return cls(model, registry.create("integrator", integrator, **settings))
+        return cls(model, registry.create("integrator", integrator, **settings), registry=registry)
 
     def run_batch(
         self,
