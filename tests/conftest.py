@@ -4,7 +4,6 @@ import importlib
 import importlib.util
 import os
 import sys
-import types
 from pathlib import Path
 
 import numpy as np
@@ -87,16 +86,14 @@ def docs_plugins() -> dict[str, object]:
 
 @pytest.fixture(scope="session")
 def docs_registry(docs_plugins: dict[str, object]) -> pi.PluginRegistry:
-    """The installed plug-ins and the integrator and failure model of docs/plugins.md."""
-
-    @pi.hookimpl
-    def plateimpact_register(registry: pi.PluginRegistry) -> None:
-        registry.add(docs_plugins["ClassicalRungeKutta"])
-        registry.add(docs_plugins["SpeedDependentPlugging"])
-
-    return pi.load_registry(
-        plugins=[types.SimpleNamespace(plateimpact_register=plateimpact_register)]
-    )
+    """The installed plug-ins and the third-party package whose modules docs/plugins.md
+    shows (its failure model ``brittle`` and integrator ``rk4`` among them)."""
+    sys.path.insert(0, str(THIRD_PARTY))
+    importlib.invalidate_caches()
+    try:
+        return pi.load_registry()
+    finally:
+        sys.path.remove(str(THIRD_PARTY))
 
 
 #: Every built-in integrator and the one written in docs/plugins.md: the event tests

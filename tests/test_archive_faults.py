@@ -25,7 +25,7 @@ from test_output_flags import CALIBRATE, SCENE
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.cli import archive_commands
+from plateimpact.cli.commands import reproduce as archive_commands
 from plateimpact.storage import upgrade as upgrading
 from plateimpact.storage.export import declared_column, netcdf_bytes
 from plateimpact.storage.lock import ArchiveBusyError, locked
@@ -67,10 +67,10 @@ def test_libhdf5_never_writes_to_a_disk(tmp_path, monkeypatch, found):
     tiny_study().run(archive=path, record_trajectory=True)
     tiny_study().run(archive=path, overwrite=True)
     limits.archive_limits(path, "l", found)
-    netcdf_bytes(pi.Archive(path), "v")
+    netcdf_bytes(pi.Archive(path), "v", registry=pi.default_registry())
     old = tmp_path / "old.h5"
     shutil.copyfile(FORMAT1, old)
-    upgrading.upgrade(old)
+    upgrading.upgrade(old, registry=pi.default_registry())
     assert opened == []
 
 
@@ -84,7 +84,7 @@ def test_a_data_file_made_in_memory_reads_as_one_written_to_a_path(tmp_path):
     archive = pi.Archive(path)
     attributes = archive.raw_attributes("v")
     on_disk = tmp_path / "direct.nc"
-    declared = {k: declared_column(k) for k in study.scenes.columns}
+    declared = {k: declared_column(k, pi.default_registry()) for k in study.scenes.columns}
     write_run_file(on_disk, study.scenes.columns, declared, study.plate_labels, result,
                    {"study": "w", "run": "v", **attributes})  # fmt: skip
     with (xr.open_dataset(archive.data_file("v"), engine="h5netcdf") as ours,
@@ -127,7 +127,7 @@ for mode in ("append", "limits", "upgrade"):
             elif mode == "limits":
                 limits.archive_limits(archive, "l", found)
             else:
-                upgrade(archive)
+                upgrade(archive, registry=pi.default_registry())
             error = ""
         except pi.ArchiveError as exc:
             error = str(exc)
@@ -180,7 +180,7 @@ def test_an_upgrade_waits_for_the_archives_writer(tmp_path):
     with locked(archive.path, archive.real, archive.lock_path, 1.0):
         with pytest.warns(pi.ArchiveWaitWarning, match="waiting for it"):
             with pytest.raises(ArchiveBusyError, match="stayed busy"):
-                upgrading.upgrade(path, wait=0.0)
+                upgrading.upgrade(path, wait=0.0, registry=pi.default_registry())
     assert path.read_bytes() == FORMAT1.read_bytes() and not archive.data.exists()
     assert not upgrading.backup_path(path).exists()
 
@@ -199,7 +199,7 @@ def _killed_at(stage: str, path: Path, nth: int = 1) -> int:
                     os.kill(os.getpid(), signal.SIGKILL)
 
             upgrading.fault_point = die
-            upgrading.upgrade(path)
+            upgrading.upgrade(path, registry=pi.default_registry())
         finally:
             os._exit(0)
     return os.waitpid(pid, 0)[1]
@@ -215,7 +215,7 @@ def test_an_upgrade_killed_at_any_stage_leaves_an_archive_and_a_rerun_completes(
     assert pi.Archive(path).runs() == original.runs()  # an archive at the path, whole
     if stage != "replaced":
         assert pi.Archive(path).version() == 1 and path.read_bytes() == FORMAT1.read_bytes()
-        kept = upgrading.upgrade(path)
+        kept = upgrading.upgrade(path, registry=pi.default_registry())
     else:
         code, _, err = run_cli(["upgrade", str(path)])
         assert_one_line(code, err, "nothing to upgrade")
@@ -262,7 +262,7 @@ def test_an_upgrade_where_hard_links_are_not_allowed_keeps_a_copy(tmp_path, monk
         raise OSError(errno.EPERM, os.strerror(errno.EPERM))
 
     monkeypatch.setattr(os, "link", no_links)
-    kept = upgrading.upgrade(path)
+    kept = upgrading.upgrade(path, registry=pi.default_registry())
     assert kept.read_bytes() == FORMAT1.read_bytes() and pi.Archive(path).version() == 2
 
 

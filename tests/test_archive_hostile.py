@@ -22,7 +22,7 @@ from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.cli import archive_commands
+from plateimpact.cli.commands import reproduce as archive_commands
 from plateimpact.limits.archived import attributes_of
 from plateimpact.storage import lock as locking
 from plateimpact.storage.output import write_text

@@ -38,7 +38,7 @@ VARIANT = pi.Variant(
     "rate", resistance="rate-poncelet", resistance_settings={"reference_speed": 50.0}
 )
 #: The line of the rate law that the "new release" changes (and so its results).
-LAW = "strength = batch.a * (1.0 + batch.rate_sensitivity * rate)"
+LAW = "strength = scenes.a * (1.0 + scenes.rate_sensitivity * rate)"
 
 
 def sha256_of_modules(modules: dict[str, Path]) -> str:
@@ -52,15 +52,19 @@ def sha256_of_modules(modules: dict[str, Path]) -> str:
 
 
 def isotropic_sha256(site: Path) -> str:
-    """The rate law's source hash, from the rule: its module (the package's __init__),
-    what it imports from the built-ins' package by name, plateimpact_plugins.report, and
-    what that imports (its constants, the failure plane, the P* table), with the enclosing
-    package's __init__ (not followed: the built-in plug-ins themselves)."""
+    """The rate law's source hash, from the rule: its module (the package's __init__), the
+    package's modules that imports (its failure model and integrator), what they import
+    from the built-ins' package by name, plateimpact_plugins.report, and what that imports
+    (its constants, the failure plane, the P* table), with the enclosing package's
+    __init__ (not followed: the built-in plug-ins themselves)."""
     modules = {
         PACKAGE: site / PACKAGE / "__init__.py",
         "plateimpact_plugins": BUILTINS / "__init__.py",
         "plateimpact_plugins.report": BUILTINS / "report" / "__init__.py",
     }
+    for path in (site / PACKAGE).glob("*.py"):
+        if path.stem != "__init__":
+            modules[f"{PACKAGE}.{path.stem}"] = path
     for stem in ("constants", "plane", "pstar_table"):
         modules[f"plateimpact_plugins.report.{stem}"] = BUILTINS / "report" / f"{stem}.py"
     return sha256_of_modules(modules)
@@ -170,7 +174,9 @@ def test_a_new_version_of_the_distribution_is_refused_on_resume(site, tmp_path, 
 def test_a_run_recorded_before_plug_in_provenance_is_refused_on_resume(tmp_path, chunks):
     path = tmp_path / "old.h5"
     shutil.copy(FORMAT1, path)
-    upgrade(path)  # format 2, its runs' attributes copied as they were: no plugins
+    upgrade(
+        path, registry=pi.default_registry()
+    )  # format 2, its runs' attributes copied as they were: no plugins
     before = files_of(path)
     with pytest.raises(StaleRunError) as refused:
         pi.Study.from_archive(path).run(archive=path, resume=True)
@@ -368,7 +374,7 @@ def test_experiment_outputs_are_kept_only_while_their_recorded_code_is_current(
 def test_a_plain_run_computes_no_record(monkeypatch, capsys):
     """``run`` without ``--json`` prints no provenance, so it computes none (no hash, no
     git): it costs what it did before the code was recorded."""
-    from plateimpact.cli import scene_commands  # noqa: PLC0415
+    from plateimpact.cli.commands import run as scene_commands  # noqa: PLC0415
 
     asked = []
     monkeypatch.setattr(scene_commands, "inputs_record", lambda *a, **k: asked.append(a) or {})

@@ -31,7 +31,7 @@ CORE = ROOT / "framework" / "plateimpact"
 #: command's options and output (the procedure itself is the report room's, found through
 #: the registry) move to the room once commands can be plug-ins. Nothing may be added.
 NOT_YET: dict[str, str] = {
-    "cli/calibrate.py": "the calibrate command (--fit ab)",
+    "cli/commands/calibrate.py": "the calibrate command (--fit ab)",
     "cli/calibrate_pstar.py": "the calibrate command (--fit pstar)",
 }
 

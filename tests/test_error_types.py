@@ -17,7 +17,8 @@ import pytest
 
 import plateimpact as pi
 from plateimpact import presets
-from plateimpact.cli import info, main
+from plateimpact.cli import main
+from plateimpact.cli.commands import plugins as info
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/3.18")
@@ -154,14 +155,14 @@ def test_a_good_batch_is_unchanged_by_the_checks():
     np.testing.assert_array_equal(wider.extra, [2.0] * 4)
 
 
-def _bug(args: object) -> None:
+def _bug(*args: object) -> None:
     raise RuntimeError("index out of step\nsecond line of the message")
 
 
 @pytest.fixture
 def buggy_plugins_command(monkeypatch, tmp_path):
     """`plateimpact plugins` with a bug in it; tracebacks go under tmp_path."""
-    monkeypatch.setattr(info, "plugins_command", _bug)
+    monkeypatch.setattr(info, "run", _bug)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
 
 
@@ -203,9 +204,9 @@ def test_a_traceback_that_cannot_be_written_is_said_on_the_same_line(
 
 
 def test_an_interrupt_is_one_line_and_exit_code_130(monkeypatch, capsys):
-    def interrupted(args: object) -> None:
+    def interrupted(*args: object) -> None:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(info, "plugins_command", interrupted)
+    monkeypatch.setattr(info, "run", interrupted)
     assert main(["plugins"]) == 130
     assert capsys.readouterr().err == "plateimpact: interrupted\n"

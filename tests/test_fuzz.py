@@ -334,7 +334,9 @@ def test_nested_duplicated_and_huge_json_gives_one_line_errors(run_record, edits
     import json  # noqa: PLC0415
 
     record = json.loads(run_record)["inputs"]
-    plate = pi.storage.plate_file.plate_to_dict(presets.plate("2024-T3/3.18"))
+    plate = pi.storage.plate_file.plate_to_dict(
+        presets.plate("2024-T3/3.18"), registry=pi.default_registry()
+    )
     with tempfile.TemporaryDirectory() as directory:
         for name, value in (("run.json", record), ("plate.json", plate)):
             text = _edited(json.dumps(value), edits)

@@ -127,24 +127,25 @@ def test_compare_prints_hostile_stored_limits_inert(hostile_archive):
 
 
 def test_the_one_line_error_escapes_what_a_message_carries(monkeypatch):
-    from plateimpact.cli import info
+    from plateimpact.cli.commands import presets
 
-    def hostile(args):
+    def hostile(*args):
         raise PlateImpactError(f"from a file: {HOSTILE}")
 
-    monkeypatch.setattr(info, "presets_command", hostile)
+    monkeypatch.setattr(presets, "run", hostile)
     code, out, err = run_cli(["presets"])
     assert_one_inert_line(code, err)
     assert err == f"plateimpact: error: from a file: {ESCAPED}\n"
 
 
 def test_a_warning_quoting_a_file_is_one_inert_line(monkeypatch):
-    from plateimpact.cli import info
+    from plateimpact.cli.commands import presets
 
-    def warns(args):
+    def warns(*args):
         warnings.warn(f"skipped {HOSTILE}", PlateImpactWarning, stacklevel=1)
+        return 0
 
-    monkeypatch.setattr(info, "presets_command", warns)
+    monkeypatch.setattr(presets, "run", warns)
     code, out, err = run_cli(["presets"])
     assert code == 0 and err == f"plateimpact: warning: skipped {ESCAPED}\n"
 
@@ -163,7 +164,9 @@ def test_an_inputs_records_hostile_label_prints_inert(tmp_path):
 
 
 def plate_text(**changes: object) -> str:
-    record = pi.storage.plate_file.plate_to_dict(presets.plate("2024-T3/3.18"))
+    record = pi.storage.plate_file.plate_to_dict(
+        presets.plate("2024-T3/3.18"), registry=pi.default_registry()
+    )
     return json.dumps({**record, **changes})
 
 

@@ -210,7 +210,7 @@ def test_event_root_finding_ends_on_the_event_side_within_the_resolution(blur):
     resolution of the root, also when the margin wiggles by 1e-12 around its root, as a
     difference of larger lengths does at rounding (how many evaluations that takes is a
     benchmark: benchmarks/event_location.py)."""
-    from plateimpact.solve.events import locate
+    from plateimpact.solve.event_location import locate
 
     levels = np.random.default_rng(1).uniform(0.05, 1.0, 200)
     coefficients = np.zeros((3, 1, levels.size))

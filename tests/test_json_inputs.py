@@ -14,7 +14,7 @@ import pytest
 from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
-from plateimpact import cli, presets
+from plateimpact import presets
 from plateimpact.base.errors import ParameterError
 from plateimpact.storage.plate_file import plate_to_dict
 from plateimpact_plugins.plugging import Plugging
@@ -84,7 +84,7 @@ def plate_file(tmp_path: Path, text: str) -> list[str]:
 
 
 def plate_text() -> str:
-    return json.dumps(plate_to_dict(presets.plate("2024-T3/3.18")))
+    return json.dumps(plate_to_dict(presets.plate("2024-T3/3.18"), registry=pi.default_registry()))
 
 
 def test_a_plate_file_with_a_key_twice_is_refused_not_the_last_winning(tmp_path):
@@ -108,7 +108,7 @@ def test_a_plate_file_with_a_key_twice_is_refused_not_the_last_winning(tmp_path)
     ],
 )
 def test_a_plate_file_with_a_bad_number_is_one_line_naming_the_key(tmp_path, key, literal, named):
-    record = plate_to_dict(presets.plate("2024-T3/3.18"))
+    record = plate_to_dict(presets.plate("2024-T3/3.18"), registry=pi.default_registry())
     text = json.dumps(record).replace(f'"{key}": {json.dumps(record[key])}', f'"{key}": {literal}')
     assert text != json.dumps(record)
     code, out, err = run_cli(plate_file(tmp_path, text))
@@ -132,8 +132,6 @@ def tuned(monkeypatch):
     """The command line with ``tuned-plugging`` registered beside the built-ins."""
     import types
 
-    from plateimpact.cli import options
-
     @pi.hookimpl
     def plateimpact_register(registry: pi.PluginRegistry) -> None:
         registry.add(TunedPlugging)
@@ -141,8 +139,8 @@ def tuned(monkeypatch):
     registry = pi.load_registry(
         plugins=[types.SimpleNamespace(plateimpact_register=plateimpact_register)]
     )
-    monkeypatch.setattr(cli, "default_registry", lambda: registry)
-    monkeypatch.setattr(options, "default_registry", lambda: registry)
+    # the command line's one registry (cli.main loads it where none is given)
+    monkeypatch.setattr("plateimpact.registry.plugin_registry.default_registry", lambda: registry)
     return ["run", "--preset", "2024-T3/3.18", "--speed", "500", "--obliquity", "45",
             "--failure", "tuned-plugging"]  # fmt: skip
 

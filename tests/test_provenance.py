@@ -192,9 +192,11 @@ def test_plate_files_round_trip_exactly():
     plate = pi.presets.plate("2024-T3/3.18").with_constants(
         critical_penetration=2.7e-3, failure_angle=np.radians(40.0)
     )
-    data = plate_to_dict(plate)
+    registry = pi.default_registry()
+    data = plate_to_dict(plate, registry=registry)
     assert data["alpha_deg"] == 40 and data["pstar_mm"] == 2.7 and data["thickness_mm"] == 3.18
-    assert plate_from_dict(json.loads(json.dumps(data))) == plate  # the same bits
+    back = plate_from_dict(json.loads(json.dumps(data)), registry=registry)
+    assert back == plate  # the same bits
 
 
 # -- run --json and --inputs ----------------------------------------------------------

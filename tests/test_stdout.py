@@ -11,12 +11,16 @@ does, so that the interpreter's own flush at exit is part of what is checked."""
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
+from plateimpact.cli.commands import COMMANDS
+
 SHOTS = Path(__file__).resolve().parents[1] / "studies" / "data"
+FORMAT1 = Path(__file__).parent / "data" / "format1.h5"
 
 #: The child: fd 1 -> /dev/full (buffered or line by line) or closed, then main.
 DRIVER = textwrap.dedent(
@@ -75,6 +79,8 @@ def commands(archive: Path, tmp: Path) -> list[list[str]]:
         "impact_speed_m_s,impact_obliquity_deg,perforated\n300,45,0\n400,45,0\n600,45,1\n"
     )
     scene = [*preset, "--speed", "500", "--obliquity", "45"]
+    old = tmp / "format1.h5"  # upgrade's: rewritten by the first case, refused by the rest
+    shutil.copy(FORMAT1, old)
     return [
         ["--version"],
         ["--help"],
@@ -99,11 +105,17 @@ def commands(archive: Path, tmp: Path) -> list[list[str]]:
         ["compare", str(archive), "2024-T3_3.18mm/plugging", "2024-T3_3.18mm/large-pstar"],
         ["compare", str(archive), "limits/map_2024-T3_3.18", "limits/map_2024-T3_6.35"],
         ["export", str(archive), "--run", "2024-T3_1.27mm/plugging", "--to", str(tmp / "e.csv")],
+        ["plot", str(archive), "--run", "2024-T3_3.18mm/plugging", "--out", str(tmp / "p.png"),
+         "--dpi", "50"],
+        ["upgrade", str(old)],
+        ["reproduce", "--quick", "--out", str(tmp / "r"), "--dpi", "50"],
     ]  # fmt: skip
 
 
 def test_every_command_on_a_full_or_closed_standard_output_is_one_line(quick_report, tmp_path):
     every = commands(quick_report / "report.h5", tmp_path)
+    # every command of the table is among them (a new command must be added here)
+    assert {argv[0] for argv in every if not argv[0].startswith("-")} == {c.name for c in COMMANDS}
     cheap = [argv for argv in every if argv[0] in ("--version", "--help", "presets", "plugins")]
     cases = [(argv, "buffered") for argv in every]
     cases += [(argv, "unbuffered") for argv in [*cheap, every[7], every[8]]]

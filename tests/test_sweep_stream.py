@@ -18,7 +18,8 @@ from test_progress import Pipe, Terminal, ticking
 
 import plateimpact as pi
 from plateimpact import presets
-from plateimpact.cli import SWEEP_COLUMNS, main, scene_commands, sweep_csv
+from plateimpact.cli import SWEEP_COLUMNS, main, sweep_csv
+from plateimpact.cli.commands import sweep as scene_commands
 from plateimpact.storage import output
 
 PLATE = "2024-T3/3.18"

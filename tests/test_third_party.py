@@ -153,3 +153,77 @@ def test_a_constant_declared_two_ways_is_refused(with_third_party):
         pi.PluginError, match="declares plate constant 'a' unlike resistance poncelet"
     ):
         registry.add(impostor)
+
+
+def brittle_rk4(registry):
+    """The package's failure model and integrator, each with a setting."""
+    return pi.Simulation.from_names(
+        failure="brittle",
+        integrator="rk4",
+        failure_settings={"residual_resistance": 0.25},
+        integrator_settings={"step": 0.005},
+        registry=registry,
+    )
+
+
+def test_its_failure_model_and_integrator_from_the_command_line_and_a_plate_file(
+    with_third_party, tmp_path
+):
+    registry = pi.load_registry()
+    plate = attrs.evolve(PLATE, critical_penetration=2e-3)
+    expected = brittle_rk4(registry).run(pi.Scene(SPHERE, plate, 900.0, np.radians(20.0)))
+    assert expected.plate_failed and expected.outcome == pi.Outcome.PERFORATION
+    plate_file = tmp_path / "plate.json"
+    plate_file.write_text(plate_file_text(plate, registry=registry))
+    model = ["--failure", "brittle", "--set", "failure.residual_resistance=0.25"]
+    model += ["--integrator", "rk4", "--set", "integrator.step=0.005"]
+    scene = ["--speed", "900", "--obliquity", "20", "--json"]
+    for source in (
+        ["--preset", "6061-T6/9.53", "--pstar", "2"],
+        ["--plate-file", str(plate_file)],
+    ):
+        out = json.loads(run_cli("run", *source, *scene, *model).stdout)
+        assert out["outcome"] == "perforation"
+        assert out["exit_speed_m_s"] == expected.exit_speed
+        assert out["model"]["failure"] == "brittle"
+        assert out["model"]["failure_settings"] == {"residual_resistance": 0.25}
+        assert out["model"]["integrator_settings"]["step"] == 0.005
+    bad = run_cli(
+        "run",
+        "--preset",
+        "6061-T6/9.53",
+        *scene,
+        *model[:2],
+        "--set",
+        "failure.residual_resistance=2",
+        check=False,
+    )
+    assert (
+        bad.returncode == 2
+        and "--set failure.residual_resistance: residual_resistance must be in [0, 1]" in bad.stderr
+    )
+
+
+def test_its_failure_model_and_integrator_in_a_study_archive_with_resume(
+    with_third_party, tmp_path
+):
+    registry = pi.load_registry()
+    variant = pi.Variant(
+        "brittle",
+        failure="brittle",
+        integrator="rk4",
+        failure_settings={"residual_resistance": 0.25},
+        integrator_settings={"step": 0.005},
+    )
+    plate = attrs.evolve(PLATE, critical_penetration=2e-3)
+    study = pi.Study.grid("brittle", [plate], [0, 30], np.linspace(400, 1200, 4), variant)
+    path = tmp_path / "a.h5"
+    results = study.run(archive=path, registry=registry)
+    meta = pi.Archive(path).metadata("brittle")
+    assert meta["model"]["failure"] == "brittle" and meta["model"]["integrator"] == "rk4"
+    assert meta["variant"]["failure_settings"] == {"residual_resistance": 0.25}
+    again = pi.Study.from_archive(path).run(archive=path, resume=True, registry=registry)
+    assert pi.Archive(path).runs() == ["brittle/brittle"]  # read back, not run again
+    np.testing.assert_array_equal(again["brittle"].exit_speed, results["brittle"].exit_speed)
+    direct = brittle_rk4(registry).run_batch(study.scenes)
+    np.testing.assert_array_equal(results["brittle"].exit_speed, direct.exit_speed)

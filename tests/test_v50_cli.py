@@ -242,7 +242,7 @@ def test_more_fits_than_the_bound_are_refused_before_any_fit_unless_forced(
     def no_fit(*args, **kwargs):
         raise AssertionError("a fit ran before the request was checked")
 
-    monkeypatch.setattr("plateimpact.cli.v50_command.fit_v50", no_fit)
+    monkeypatch.setattr("plateimpact.cli.commands.v50.fit_v50", no_fit)
     assert main(["v50", str(shots_csv), "--by-obliquity", "--bootstrap", "600000"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "1,200,002 fits" in err and "--force" in err

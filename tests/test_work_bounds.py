@@ -141,7 +141,7 @@ def test_validate_runs_its_shots_a_chunk_at_a_time_bit_for_bit(monkeypatch, batc
 def test_validate_on_the_command_line_names_force_and_force_lifts_the_bound(tmp_path, monkeypatch):
     path = tmp_path / "shots.csv"
     path.write_text(SHOTS.to_csv_text())
-    monkeypatch.setattr("plateimpact.cli.validate.MAX_VALIDATE_SCENES", 1000)
+    monkeypatch.setattr("plateimpact.cli.commands.validate.MAX_VALIDATE_SCENES", 1000)
     argv = ["validate", str(path), "--preset", "2024-T3/1.27"]
     code, _, err = run_cli(argv)
     assert_one_line(code, err, "validate: up to 1,408 scenes", "more than 1,000", "--force")
@@ -158,7 +158,7 @@ def test_the_ab_fit_is_bounded_before_any_scene_by_its_normal_shots(no_scene, mo
     plate = presets.plate("2024-T3/3.18")
     with pytest.raises(WorkBoundError, match=r"up to 3,195 scenes .* more than 3,194"):
         report.calibrate(shots, plate, max_scenes=3194)
-    monkeypatch.setattr("plateimpact.cli.calibrate.MAX_FIT_SCENES", 3194)
+    monkeypatch.setattr("plateimpact.cli.commands.calibrate.MAX_FIT_SCENES", 3194)
     argv = ["calibrate", str(ROOT / NORMAL), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
     code, _, err = run_cli(argv)
     assert_one_line(code, err, "a, b fit: up to 3,195 scenes", "--force")

@@ -27,6 +27,15 @@ _EXPORTS: dict[str, str] = {
     "BoundResistance": "model.resistance",
     "contact_force": "model.resistance",
     "FailureModel": "model.failure",
+    "Contact": "model.failure",
+    "Event": "model.events",
+    "EVENTS": "model.events",
+    "FAILURE_EVENTS": "model.events",
+    "FAILURE_ONSET": "model.events",
+    "LOSS_OF_CONTACT": "model.events",
+    "PERFORATION": "model.events",
+    "REST": "model.events",
+    "TURN_BACK": "model.events",
     "Integrator": "solve.integrator",
     "Step": "solve.integrator",
     "StepControl": "solve.integrator",
@@ -35,6 +44,7 @@ _EXPORTS: dict[str, str] = {
     "MAX_SECONDS": "solve.integrator",
     "RTOL": "solve.integrator",
     "Column": "model.plugin",
+    "Plugin": "model.plugin",
     "Dynamics": "solve.dynamics",
     "DenseOutput": "solve.dense",
     "PolynomialDenseOutput": "solve.dense",
@@ -52,13 +62,13 @@ _EXPORTS: dict[str, str] = {
     "LATERAL": "model.impact",
     "OBLIQUITY": "model.impact",
     "SPEED": "model.impact",
-    "ONSET": "model.impact",
-    "CONTACT_LOST": "model.impact",
-    "PERFORATED": "model.impact",
-    "AT_REST": "model.impact",
-    "TURNED_BACK": "model.impact",
-    "EVENT_NAMES": "model.impact",
-    "EVENT_OUTCOMES": "model.impact",
+    "ONSET": "model.events",
+    "CONTACT_LOST": "model.events",
+    "PERFORATED": "model.events",
+    "AT_REST": "model.events",
+    "TURNED_BACK": "model.events",
+    "EVENT_NAMES": "model.events",
+    "EVENT_OUTCOMES": "model.events",
     "contact_geometry": "model.geometry",
     "contact_lost_margin": "model.geometry",
     "force_inclination": "model.geometry",
@@ -209,24 +219,34 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .model import batch, geometry
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
-    from .model.failure import FailureModel
-    from .model.geometry import contact_geometry, contact_lost_margin, force_inclination
-    from .model.impact import (
+    from .model.events import (
         AT_REST,
         CONTACT_LOST,
         EVENT_NAMES,
         EVENT_OUTCOMES,
+        EVENTS,
+        FAILURE_EVENTS,
+        FAILURE_ONSET,
+        LOSS_OF_CONTACT,
+        ONSET,
+        PERFORATED,
+        PERFORATION,
+        REST,
+        TURN_BACK,
+        TURNED_BACK,
+        Event,
+    )
+    from .model.failure import Contact, FailureModel
+    from .model.geometry import contact_geometry, contact_lost_margin, force_inclination
+    from .model.impact import (
         KINEMATIC_STATE,
         LATERAL,
         OBLIQUITY,
-        ONSET,
         PENETRATION,
-        PERFORATED,
         SPEED,
-        TURNED_BACK,
         ImpactModel,
     )
-    from .model.plugin import Column
+    from .model.plugin import Column, Plugin
     from .model.ragged import Ragged
     from .model.resistance import BoundResistance, ResistanceLaw, contact_force
     from .model.results import BatchResult, CraterSection, Outcome, Result, Trajectory

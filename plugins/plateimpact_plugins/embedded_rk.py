@@ -117,6 +117,9 @@ class EmbeddedRungeKutta(Integrator):
     def start(self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray) -> StepperState:
         return {"derivative": dynamics.rates(y)}  # first same as last
 
+    def known_rates(self, state: StepperState) -> np.ndarray:
+        return state["derivative"]
+
     def advance(
         self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray, h: np.ndarray, state: StepperState
     ) -> Step:

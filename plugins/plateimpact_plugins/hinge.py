@@ -7,7 +7,7 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import BoundResistance, Column, Parameter, Range, SceneBatch
+from plateimpact import Column, Contact, Parameter, Range, SceneBatch
 
 from .report.constants import CRITICAL_PENETRATION, FAILURE_ANGLE
 from .separation import PlaneSeparation
@@ -80,85 +80,60 @@ class Hinge(PlaneSeparation):
     finger_area_scale: float = FINGER_AREA_SCALE.field()
     hinge_obliquity: float | None = HINGE_OBLIQUITY.field()
 
-    def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
-        return batch.critical_penetration
+    def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:
+        return scenes.critical_penetration
 
-    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
+    def prepare(self, scenes: SceneBatch) -> dict[str, np.ndarray]:
         if self.hinge_obliquity is None:
-            theta1 = HALF_PI - batch.failure_angle
+            theta1 = HALF_PI - scenes.failure_angle
             # 90° − θ1 kept as α* itself, not recomputed: with β = 2α* the finger force
             # then lies exactly along the normal at θ = 0 (no lift from rounding).
-            opening = batch.failure_angle
+            opening = scenes.failure_angle
         else:
-            theta1 = np.full(batch.size, self.hinge_obliquity)
+            theta1 = np.full(scenes.size, self.hinge_obliquity)
             opening = HALF_PI - theta1
-        return {**super().prepare(batch), "theta1": theta1, "hinge_opening": opening}
+        return {**super().prepare(scenes), "theta1": theta1, "hinge_opening": opening}
 
-    def initial_state(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        batch: SceneBatch,
-    ) -> np.ndarray:
-        full = 2.0 * batch.failure_angle
-        return (full - np.maximum(obliquity - batch.theta1, 0.0))[np.newaxis]
+    def initial_state(self, contact: Contact) -> np.ndarray:
+        scenes = contact.scenes
+        full = 2.0 * scenes.failure_angle
+        return (full - np.maximum(contact.obliquity - scenes.theta1, 0.0))[np.newaxis]
 
-    def state_rates(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        obliquity_rate: np.ndarray,
-        state: np.ndarray,
-        batch: SceneBatch,
-    ) -> np.ndarray:
-        finger_angle = state[0]
-        held = (obliquity <= batch.theta1) & (finger_angle >= 2.0 * batch.failure_angle)
-        peeling = np.maximum(obliquity_rate + speed / batch.radius, 0.0)  # eq 18 per unit time
+    def state_rates(self, contact: Contact) -> np.ndarray:
+        scenes, obliquity = contact.scenes, contact.obliquity
+        assert contact.obliquity_rate is not None  # given wherever rates are asked for
+        finger_angle = contact.failure_state[0]
+        held = (obliquity <= scenes.theta1) & (finger_angle >= 2.0 * scenes.failure_angle)
+        # eq 18 per unit time
+        peeling = np.maximum(contact.obliquity_rate + contact.speed / scenes.radius, 0.0)
         return np.where(held | (finger_angle <= 0.0), 0.0, -peeling)[np.newaxis]
 
-    def branch_margins(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        state: np.ndarray,
-        batch: SceneBatch,
-    ) -> np.ndarray:
+    def branch_margins(self, contact: Contact) -> np.ndarray:
         # Besides the relief's: θ − θ1 [rad], where ψ″ switches from eq 19 to eq 20 and β
         # starts to shrink, and β [rad], which stops the finger at 0.
-        finger_rows = np.stack([obliquity - batch.theta1, state[0]])
-        return np.concatenate(
-            [super().branch_margins(penetration, obliquity, state, batch), finger_rows]
-        )
+        theta1 = contact.scenes.theta1
+        finger_rows = np.stack([contact.obliquity - theta1, contact.failure_state[0]])
+        return np.concatenate([super().branch_margins(contact), finger_rows])
 
     def finger(
-        self, obliquity: np.ndarray, finger_angle: np.ndarray, batch: SceneBatch
+        self, obliquity: np.ndarray, finger_angle: np.ndarray, scenes: SceneBatch
     ) -> tuple[np.ndarray, np.ndarray]:
         """The finger's presented area As [m²] (eq 17) and the angle ψ″ [rad] of its force
-        from the path (eqs 19–20). The finger touches the sphere over the cap of angular
-        width β centred on that force line, i.e. from θ − ψ″ − β/2 to θ − ψ″ + β/2 from
-        the plate normal."""
+        from the path (eqs 19–20), at obliquity θ [rad] and finger angle β [rad]. The
+        finger touches the sphere over the cap of angular width β centred on that force
+        line, i.e. from θ − ψ″ − β/2 to θ − ψ″ + β/2 from the plate normal."""
         half_angle = 0.5 * np.maximum(finger_angle, 0.0)
-        area = self.finger_area_scale * np.pi * (batch.radius * np.sin(half_angle)) ** 2
-        theta1 = batch.theta1
+        area = self.finger_area_scale * np.pi * (scenes.radius * np.sin(half_angle)) ** 2
+        theta1 = scenes.theta1
         incidence = np.where(
             obliquity < theta1,
-            obliquity + (batch.hinge_opening - half_angle),  # eq 19: 90° + θ − θ1 − β/2
+            obliquity + (scenes.hinge_opening - half_angle),  # eq 19: 90° + θ − θ1 − β/2
             HALF_PI - half_angle,  # eq 20
         )
         return area, incidence
 
-    def force_change(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        state: np.ndarray,
-        batch: SceneBatch,
-        law: BoundResistance,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        drag, lift = self.relief(penetration, obliquity, speed, batch, law)
-        area, incidence = self.finger(obliquity, state[0], batch)
-        finger_force = area * law.stress(speed, incidence)  # eq 16
+    def force_change(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
+        drag, lift = self.relief(contact)
+        area, incidence = self.finger(contact.obliquity, contact.failure_state[0], contact.scenes)
+        finger_force = area * contact.law.stress(contact.speed, incidence)  # eq 16
         return drag + finger_force * np.cos(incidence), lift + finger_force * np.sin(incidence)

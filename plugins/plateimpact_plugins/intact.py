@@ -7,7 +7,7 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import BoundResistance, FailureModel, SceneBatch
+from plateimpact import Contact, FailureModel, SceneBatch
 
 
 @final
@@ -16,26 +16,20 @@ class Intact(FailureModel):
     """The plate never fails, whatever P* says: the sphere ricochets or embeds.
 
     The report's force law has no back surface, so an intact plate behaves as a
-    half-space; this is the report's "extremely large P*" limit.
+    half-space; this is the report's "extremely large P*" limit. It adds neither failure
+    event, so the driver evaluates neither margin; its methods say the same thing on
+    their own (onset never, no change, never perforated).
     """
 
     name = "intact"
+    events = ()
 
-    def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
-        return np.full(batch.size, np.inf)
+    def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:
+        return np.full(scenes.size, np.inf)
 
-    def force_change(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        state: np.ndarray,
-        batch: SceneBatch,
-        law: BoundResistance,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        raise AssertionError("an intact plate has no failed scenes")  # onset is inf
+    def force_change(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
+        nothing = np.zeros(contact.penetration.shape)
+        return nothing, nothing.copy()
 
-    def perforation_margin(
-        self, penetration: np.ndarray, obliquity: np.ndarray, batch: SceneBatch
-    ) -> np.ndarray:
-        return np.full(penetration.shape, -np.inf)
+    def perforation_margin(self, contact: Contact) -> np.ndarray:
+        return np.full(contact.penetration.shape, -np.inf)

@@ -22,5 +22,5 @@ class Plugging(PlaneSeparation):
     name = "plugging"
     plate_constants = (CRITICAL_PENETRATION, FAILURE_ANGLE)
 
-    def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
-        return batch.critical_penetration
+    def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:
+        return scenes.critical_penetration

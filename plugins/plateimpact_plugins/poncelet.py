@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import final
+from typing import Any, final
 
 import attrs
 import numpy as np
@@ -10,6 +10,14 @@ import numpy as np
 from plateimpact import ResistanceLaw, SceneBatch
 
 from .report.constants import DENSITY_B, STRENGTH_A
+
+
+def poncelet_stress(speed: Any, incidence: Any, a: Any, b: Any) -> Any:
+    """σ = a + b (V cos ψ)² [N/m²] (eq 1) at speed V [m/s] and incidence ψ [rad], with a
+    [N/m²] and b [kg/m³]: the formula once, on numbers or arrays alike (numpy arithmetic
+    only, so that a compiled path can compile this very function)."""
+    normal_speed = speed * np.cos(incidence)
+    return a + b * normal_speed * normal_speed
 
 
 @final
@@ -24,6 +32,5 @@ class Poncelet(ResistanceLaw):
     name = "poncelet"
     plate_constants = (STRENGTH_A, DENSITY_B)
 
-    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
-        normal_speed = speed * np.cos(incidence)
-        return batch.a + batch.b * normal_speed * normal_speed
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
+        return poncelet_stress(speed, incidence, scenes.a, scenes.b)

@@ -117,7 +117,6 @@ class Segment(Integrator):
         dt = h / self.SEGMENTS
         starts = np.empty((self.SEGMENTS, *y.shape))
         rates = np.empty_like(starts)
-        rest_speed = dynamics.batch.core.rest_speed
         current = y
         for j in range(self.SEGMENTS):
             starts[j] = current
@@ -126,7 +125,7 @@ class Segment(Integrator):
             # a force evaluated there (V² of a speed far below zero, lift/(m V) of one
             # near it) would overflow. Such scenes coast on unchanged for the rest of the
             # step instead.
-            stopped = current[SPEED] <= rest_speed
+            stopped = dynamics.at_rest(current)
             if stopped.any():
                 rates[j] = dynamics.rates(np.where(stopped, y, current))
                 rates[j][:, stopped] = 0.0

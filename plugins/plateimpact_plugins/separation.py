@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from plateimpact import BoundResistance, Column, FailureModel, Parameter, SceneBatch, geometry
+from plateimpact import Column, Contact, FailureModel, Parameter, SceneBatch, geometry
 
 from .report.constants import FAILURE_ANGLE
 from .report.plane import failure_plane_depth
@@ -37,53 +37,33 @@ class PlaneSeparation(FailureModel):
     )
 
     @abstractmethod
-    def onset_penetration(self, batch: SceneBatch) -> np.ndarray: ...
+    def onset_penetration(self, scenes: SceneBatch) -> np.ndarray: ...
 
-    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
-        onset = self.onset_penetration(batch)
-        return {
-            "failure_plane_depth": failure_plane_depth(batch.radius, batch.failure_angle, onset)
-        }
+    def prepare(self, scenes: SceneBatch) -> dict[str, np.ndarray]:
+        onset = self.onset_penetration(scenes)
+        depth = failure_plane_depth(scenes.radius, scenes.failure_angle, onset)  # eq 8
+        return {"failure_plane_depth": depth}
 
-    def relief(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        batch: SceneBatch,
-        law: BoundResistance,
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def relief(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""
-        below_plane = penetration - batch.failure_plane_depth
-        relieved_drag, relieved_lift = law.contact_force(below_plane, obliquity, speed)
+        below_plane = contact.penetration - contact.scenes.failure_plane_depth
+        relieved_drag, relieved_lift = contact.law.contact_force(
+            below_plane, contact.obliquity, contact.speed
+        )
         return -relieved_drag, -relieved_lift
 
-    def force_change(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        speed: np.ndarray,
-        state: np.ndarray,
-        batch: SceneBatch,
-        law: BoundResistance,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        return self.relief(penetration, obliquity, speed, batch, law)
+    def force_change(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
+        return self.relief(contact)
 
-    def branch_margins(
-        self,
-        penetration: np.ndarray,
-        obliquity: np.ndarray,
-        state: np.ndarray,
-        batch: SceneBatch,
-    ) -> np.ndarray:
+    def branch_margins(self, contact: Contact) -> np.ndarray:
         # The relieved force is eqs 2–6 below the failure plane: the same branch surfaces
         # with P − h for P [m].
-        below_plane = penetration - batch.failure_plane_depth
-        return geometry.branch_margins(below_plane, obliquity, batch.radius)
+        scenes = contact.scenes
+        below_plane = contact.penetration - scenes.failure_plane_depth
+        return geometry.branch_margins(below_plane, contact.obliquity, scenes.radius)
 
-    def perforation_margin(
-        self, penetration: np.ndarray, obliquity: np.ndarray, batch: SceneBatch
-    ) -> np.ndarray:
+    def perforation_margin(self, contact: Contact) -> np.ndarray:
         # Depth of the forward hemisphere's shallowest point below the failure plane.
-        reach = batch.radius * (1.0 + np.sin(np.minimum(obliquity, 0.5 * np.pi)))
-        return penetration - batch.failure_plane_depth - reach
+        scenes = contact.scenes
+        reach = scenes.radius * (1.0 + np.sin(np.minimum(contact.obliquity, 0.5 * np.pi)))
+        return contact.penetration - scenes.failure_plane_depth - reach

@@ -35,5 +35,5 @@ class VariablePstar(PlaneSeparation):
 
     table: PstarTable = PSTAR_TABLE.field()
 
-    def onset_penetration(self, batch: SceneBatch) -> np.ndarray:
-        return self.table(batch.impact_obliquity, batch.impact_speed)
+    def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:
+        return self.table(scenes.impact_obliquity, scenes.impact_speed)

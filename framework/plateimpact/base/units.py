@@ -17,3 +17,5 @@ g = 1.0e-3
 """One gram [kg]."""
 deg = math.pi / 180.0
 """One degree [rad]."""
+us = 1.0e-6
+"""One microsecond [s] (contact times as the command line prints them)."""

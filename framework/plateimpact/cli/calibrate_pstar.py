@@ -22,24 +22,22 @@ from ..calibration import (
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
 from ..provenance.metadata import versions
-from ..registry.plugin_registry import default_registry
+from ..registry.plugin_registry import PluginRegistry
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_file_text
 from ..storage.shots import Shots
-from .common import UsageError, check_directory, say, write_atomically
+from .common import UsageError, check_directory, write_atomically
+from .formatting import ANGLE, user
 from .options import bodies, model_choice, typed
+from .writer import Writer
 
-#: The fits, and their search's constants, are the registered calibration procedure's (a
-#: plug-in package's): PstarFit, PstarTableFit and PstarEstimate are its classes.
+#: The fits, and their search's constants, are the registered calibration procedure's
+#: (``registry.procedure("calibration")``, a plug-in package's): PstarFit, PstarTableFit
+#: and PstarEstimate are its classes.
 PstarFit: TypeAlias = Any
 PstarTableFit: TypeAlias = Any
 PstarEstimate: TypeAlias = Any
-
-
-def _fits() -> Any:
-    """The registered calibration procedure (the report's, from its plug-in package)."""
-    return default_registry().procedure("calibration")
 
 
 #: The options only --fit pstar reads, with their defaults (a typed one is refused with
@@ -100,7 +98,7 @@ def refuse_pstar_options(args: argparse.Namespace) -> None:
             raise UsageError(f"{flag}: only with --fit pstar")
 
 
-def pstar_command(args: argparse.Namespace) -> None:
+def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> None:
     """Run ``plateimpact calibrate --fit pstar``."""
     for flag in ("--method", "--png"):
         if getattr(args, flag.lstrip("-")) is not None:
@@ -112,7 +110,8 @@ def pstar_command(args: argparse.Namespace) -> None:
         )
     check_directory(args.out, "--out")
     shots = Shots.from_csv(args.shots)
-    choice = model_choice(args)
+    choice = model_choice(args, registry)
+    fits = registry.procedure("calibration")  # the report's, from its plug-in package
     simulation = choice.simulation()
     if getattr(args, "pstar", None) is not None or "critical_penetration" in choice.plate:
         flag = choice.plate_flags.get("critical_penetration", "--pstar")
@@ -127,7 +126,7 @@ def pstar_command(args: argparse.Namespace) -> None:
                 "--fit pstar holds a and b fixed: give --preset, --plate-file, or --a and --b "
                 "(fit them first with --fit ab)"
             )
-        choice.plate.setdefault("critical_penetration", 1e-3)  # what the fit finds
+        choice.plate.setdefault("critical_penetration", mm)  # what the fit finds
     sphere, given_plate, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given_plate.thickness, given_plate.constants)
     typed(args).update({"speed_sigma": "--speed-sigma", "residual_sigma": "--residual-sigma"})
@@ -143,28 +142,28 @@ def pstar_command(args: argparse.Namespace) -> None:
     bound = None if args.force else MAX_FIT_SCENES
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
-            table = _fits().fit_pstar_by_obliquity(
+            table = fits.fit_pstar_by_obliquity(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
                 resolution=finder["resolution"], tolerance=finder["tolerance"],
                 max_scenes=bound,
             )  # fmt: skip
         else:
-            fit = _fits().fit_pstar(
+            fit = fits.fit_pstar(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
                 fit_alpha=args.alpha_fit, resolution=finder["resolution"],
                 tolerance=finder["tolerance"], max_scenes=bound,
             )  # fmt: skip
     if args.by_obliquity:
-        summary = _table_summary(args, table, simulation, finder, sphere)
+        summary = _table_summary(fits, args, table, simulation, finder, sphere)
         if args.out is not None:
             write_atomically(args.out, table.csv_text(), "--out")
-        say(json.dumps(summary) if args.json else _table_text(args, table))
+        out.say(json.dumps(summary) if args.json else _table_text(args, table))
         return
-    summary = _fit_summary(args, fit, simulation, finder, sphere)
+    summary = _fit_summary(fits, args, fit, simulation, finder, sphere)
     if args.out is not None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
-        write_atomically(args.out, plate_file_text(fit.plate, extra), "--out")
-    say(json.dumps(summary) if args.json else _fit_text(args, fit))
+        write_atomically(args.out, plate_file_text(fit.plate, extra, registry=registry), "--out")
+    out.say(json.dumps(summary) if args.json else _fit_text(fits, args, fit))
 
 
 def _finite(x: float) -> float | None:
@@ -187,11 +186,13 @@ def _probability_model(
     }
 
 
-def _search(finder: dict[str, float], cost: Cost, sphere_radius: float) -> dict[str, Any]:
+def _search(
+    fits: Any, finder: dict[str, float], cost: Cost, sphere_radius: float
+) -> dict[str, Any]:
     return {
-        "pstar_range_mm": [r * sphere_radius / mm for r in _fits().PSTAR_RANGE],
-        "scan_points": _fits().SCAN_POINTS,
-        "information_step_ln_pstar": _fits().PSTAR_STEP,
+        "pstar_range_mm": [r * sphere_radius / mm for r in fits.PSTAR_RANGE],
+        "scan_points": fits.SCAN_POINTS,
+        "information_step_ln_pstar": fits.PSTAR_STEP,
         "resolution_m_s": finder["resolution"],
         "tolerance_m_s": finder["tolerance"],
         "evaluations": cost.evaluations,
@@ -201,6 +202,7 @@ def _search(finder: dict[str, float], cost: Cost, sphere_radius: float) -> dict[
 
 
 def _fit_summary(
+    fits: Any,
     args: argparse.Namespace,
     fit: PstarFit,
     simulation: Simulation,
@@ -215,19 +217,19 @@ def _fit_summary(
         "residual_speed_shots": fit.residual_shots,
         "pstar_mm": e.pstar / mm,
         "pstar_mm_stderr": e.pstar_stderr / mm,
-        "alpha_deg": math.degrees(e.alpha),
+        "alpha_deg": user(ANGLE, e.alpha),
         "alpha_fitted": fit.alpha_fitted,
     }
     if fit.alpha_fitted:
-        out["alpha_deg_stderr"] = math.degrees(e.alpha_stderr)
+        out["alpha_deg_stderr"] = user(ANGLE, e.alpha_stderr)
         out["pstar_alpha_correlation"] = e.correlation
     return out | {
         "log_likelihood": e.log_likelihood,
         "converged": True,  # a fit that does not converge is an error (exit code 2)
         "shots_near_boundary": e.near,
-        "near_boundary_speed_sigmas": _fits().NEAR,
+        "near_boundary_speed_sigmas": fits.NEAR,
         "probability_model": _probability_model(args, fit.model, e.residual_sigma),
-        "search": _search(finder, fit.cost, sphere.radius),
+        "search": _search(fits, finder, fit.cost, sphere.radius),
         "note": fit.note or None,
         "plate_file": args.out,
         "model": simulation.describe(),
@@ -249,7 +251,7 @@ def _provenance(
     }
 
 
-def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
+def _fit_text(fits: Any, args: argparse.Namespace, fit: PstarFit) -> str:
     e = fit.estimate
     model = fit.model
     if math.isnan(e.residual_sigma):
@@ -264,10 +266,10 @@ def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
     else:
         sigma = f"sigma_r = {e.residual_sigma:.3g} m/s (fitted)"
     alpha = (
-        f"alpha* = {math.degrees(e.alpha):.4g} ± {math.degrees(e.alpha_stderr):.2g} deg "
+        f"alpha* = {user(ANGLE, e.alpha):.4g} ± {user(ANGLE, e.alpha_stderr):.2g} deg "
         f"(correlation with P* {e.correlation:+.2f})"
         if fit.alpha_fitted
-        else f"alpha* = {math.degrees(e.alpha):.4g} deg (given)"
+        else f"alpha* = {user(ANGLE, e.alpha):.4g} deg (given)"
     )
     lines = [
         f"shots: {args.shots}: {fit.shots} used, {fit.residual_shots} with a residual speed",
@@ -275,7 +277,7 @@ def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
         + (" (given)" if args.speed_sigma is not None else " (default)")
         + f", {sigma}, blunder {OUTCOME_BLUNDER:g}",
         f"P* = {e.pstar / mm:.5g} ± {e.pstar_stderr / mm:.2g} mm, {alpha}",
-        f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {_fits().NEAR:g} s of a "
+        f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {fits.NEAR:g} s of a "
         f"boundary; {fit.cost.evaluations} candidates in {fit.cost.batches} batches, "
         f"{fit.cost.seconds:.1f} s",
     ]
@@ -298,6 +300,7 @@ def _estimate_json(prefix: str, e: PstarEstimate, shots: int) -> dict[str, Any]:
 
 
 def _table_summary(
+    fits: Any,
     args: argparse.Namespace,
     table: PstarTableFit,
     simulation: Simulation,
@@ -306,7 +309,7 @@ def _table_summary(
 ) -> dict[str, Any]:
     rows = [
         {
-            "obliquity_deg": float(f"{math.degrees(row.obliquity):.12g}"),  # 60, not 59.99..
+            "obliquity_deg": float(f"{user(ANGLE, row.obliquity):.12g}"),  # 60, not 59.99..
             **_estimate_json("ricochet", row.ricochet, row.ricochet_shots),
             **_estimate_json("perforation", row.perforation, row.perforation_shots),
             "transition_start_m_s": row.transition_start,
@@ -319,11 +322,11 @@ def _table_summary(
         "fit": "pstar",
         "by_obliquity": True,
         "shots_file": args.shots,
-        "alpha_deg": math.degrees(table.alpha),
+        "alpha_deg": user(ANGLE, table.alpha),
         "rows": rows,
         "probability_model": _probability_model(args, table.model, math.nan)
         | {"residual_sigma_m_s": None},
-        "search": _search(finder, table.cost, sphere.radius),
+        "search": _search(fits, finder, table.cost, sphere.radius),
         "table_file": args.out,
         "model": simulation.describe(),
     }
@@ -336,14 +339,14 @@ def _table_text(args: argparse.Namespace, table: PstarTableFit) -> str:
         return f"{e.pstar / mm:.4g} ± {e.pstar_stderr / mm:.2g}"
 
     lines = [
-        f"P* by obliquity from {args.shots} (alpha* = {math.degrees(table.alpha):.4g} deg, "
+        f"P* by obliquity from {args.shots} (alpha* = {user(ANGLE, table.alpha):.4g} deg, "
         f"impact-speed scatter s = {table.model.speed_sigma:g} m/s)",
         f"{'obliquity':>9s}  {'ricochet P* [mm]':>22s}{'shots':>6s}  "
         f"{'perforation P* [mm]':>22s}{'shots':>6s}  band [m/s]",
     ]
     notes = []
     for row in table.rows:
-        degrees = f"{math.degrees(row.obliquity):.6g}"
+        degrees = f"{user(ANGLE, row.obliquity):.6g}"
         lines.append(
             f"{degrees:>9s}  {value(row.ricochet):>22s}{row.ricochet_shots:6d}  "
             f"{value(row.perforation):>22s}{row.perforation_shots:6d}  "

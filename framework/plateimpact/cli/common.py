@@ -1,12 +1,10 @@
-"""What every command shares: the one-line error, output files written atomically, and
-the one writer of standard output (:func:`say`, :func:`write_stdout`): a full or closed
-standard output is one line and exit code 2, never a traceback or Python's "Exception
-ignored" at exit."""
+"""What every command shares: the one-line usage error, the argument parser, output
+files written atomically and checked before any work (standard output is the writer's:
+:mod:`plateimpact.cli.writer`)."""
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import io
 import math
@@ -29,6 +27,7 @@ from ..storage.output import (
     write_text,
 )
 from ..storage.together import Output
+from .writer import Writer
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -39,11 +38,13 @@ class UsageError(PlateImpactError):
 
 
 class Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line and exit code 2, without the usage."""
+    """An argument parser whose errors are one line and exit code 2, without the usage,
+    and whose help and version go through the command's writer (``out``)."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, out: Writer | None = None, **kwargs: Any) -> None:
         kwargs.setdefault("allow_abbrev", False)  # a mistyped prefix is an error, not a guess
         super().__init__(*args, **kwargs)
+        self.out = out or Writer()
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"plateimpact: error: {printable(message)}\n")
@@ -52,7 +53,7 @@ class Parser(argparse.ArgumentParser):
         # --help and --version go through the one writer: argparse's own swallows a
         # failed write (and Python reports it at exit)
         if message and (file is None or file is sys.stdout):
-            write_stdout(message)
+            self.out.write(message)
         else:
             super()._print_message(message, file)
 
@@ -148,76 +149,6 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
         help=f"resolution of raster figures, {FIGURE_DPI_RANGE[0]:g}-{FIGURE_DPI_RANGE[1]:g} "
         f"dots per inch (default: {FIGURE_DPI:g}; study figures are 7.2 in wide)",
     )
-
-
-class StdoutError(OutputError):
-    """Standard output cannot take what a command prints: a full device, a closed one."""
-
-
-def stdout_closed() -> bool:
-    """Whether the command was started with standard output closed (``>&-``): Python then
-    has no ``sys.stdout``, and the next file opened would take its descriptor."""
-    if sys.stdout is None:
-        return True
-    try:
-        descriptor = sys.stdout.fileno()
-    except (AttributeError, OSError, ValueError):  # not a file: a caller's buffer
-        return False
-    try:
-        os.fstat(descriptor)
-    except OSError:
-        return True
-    return False
-
-
-def write_stdout(text: str) -> None:
-    """Print ``text`` as it is (CSV, JSON), flushed now: a standard output that cannot
-    take it (a full device, closed) is a one-line :class:`StdoutError`."""
-    if sys.stdout is None:
-        raise StdoutError("standard output is closed; redirect it (e.g. > /dev/null)")
-    try:
-        sys.stdout.write(text)
-        sys.stdout.flush()
-    except BrokenPipeError:
-        raise
-    except OSError as exc:
-        reason = exc.strerror or type(exc).__name__
-        raise StdoutError(f"standard output: cannot write: {reason}") from None
-
-
-def flush_stdout() -> None:
-    """Flush standard output (what a library printed past :func:`write_stdout`); a
-    failure is a one-line :class:`StdoutError`."""
-    if sys.stdout is None:
-        return
-    try:
-        sys.stdout.flush()
-    except BrokenPipeError:
-        raise
-    except OSError as exc:
-        reason = exc.strerror or type(exc).__name__
-        raise StdoutError(f"standard output: cannot write: {reason}") from None
-
-
-def say(text: object = "") -> None:
-    """Print one or more lines of human-readable text (and a new line): every character a
-    terminal would act on is escaped line by line (untrusted.printable), so that text
-    from a file that reached it unescaped still prints inert; then :func:`write_stdout`."""
-    lines = str(text).split("\n")
-    write_stdout("\n".join(printable(line) for line in lines) + "\n")
-
-
-def discard_stdout() -> None:
-    """After standard output failed: point its descriptor at /dev/null, so that what is
-    still buffered does not fail again at exit (Python's "Exception ignored" and exit
-    code 120). Only for a real file descriptor (not a caller's buffer)."""
-    with contextlib.suppress(AttributeError, OSError, ValueError):
-        descriptor = sys.stdout.fileno()
-        null = os.open(os.devnull, os.O_WRONLY)
-        try:
-            os.dup2(null, descriptor)
-        finally:
-            os.close(null)
 
 
 def csv_text(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:

@@ -16,21 +16,16 @@ from typing import Any
 import numpy as np
 
 from ..base.parameters import Parameter
-from ..base.untrusted import printable
 from ..model.batch import CORE_COLUMNS, SceneBatch
 from ..model.results import BatchResult
-from ..registry.plugin_registry import KINDS, default_registry
+from ..registry.plugin_registry import KINDS, PluginRegistry
 from ..storage.archive import Archive
+from .formatting import LONGEST_TEXT, shown
+
+__all__ = ["LONGEST_TEXT", "run_description", "run_lines", "scene_line", "seconds", "shown"]
 
 #: Distinct values of a scene column listed one by one; more are shown as a range.
 LISTED_VALUES = 6
-#: Longest piece of an archive's text printed [characters] (a longer one is cut, "...").
-LONGEST_TEXT = 200
-
-
-def shown(value: object, limit: int | None = LONGEST_TEXT) -> str:
-    """Text from a file, as one inert line of at most ``limit`` characters."""
-    return printable(value, limit)
 
 
 def seconds(value: object) -> str:
@@ -52,10 +47,10 @@ def _value(declared: Parameter | None, value: object) -> str:
         return shown(json.dumps(value, default=str))
 
 
-def _plugin(kind: str, model: dict[str, Any]) -> str:
-    """``dopri5 1 (rtol 1e-09, ...)``: name, version and every setting."""
+def _plugin(kind: str, model: dict[str, Any], plugins: PluginRegistry) -> str:
+    """``dopri5 1 (rtol 1e-09, ...)``: name, version and every setting (declared by
+    ``plugins`` where it has the plug-in)."""
     name = model.get(kind)
-    plugins = default_registry()
     declarations: dict[str, Parameter] = {}
     if isinstance(name, str) and name in plugins.names(kind):
         declarations = plugins.get(kind, name).setting_declarations()
@@ -69,11 +64,11 @@ def _plugin(kind: str, model: dict[str, Any]) -> str:
     return f"{shown(name)} {version} ({settings or 'no settings'})"
 
 
-def run_lines(meta: dict[str, Any]) -> list[str]:
+def run_lines(meta: dict[str, Any], registry: PluginRegistry) -> list[str]:
     """The model, commit and versions of an archived run (its metadata)."""
     model = meta.get("model")
     model = model if isinstance(model, dict) else {}
-    lines = [f"  {kind}: {_plugin(kind, model)}" for kind in KINDS]
+    lines = [f"  {kind}: {_plugin(kind, model, registry)}" for kind in KINDS]
     lines.append(f"  rest_speed_fraction: {shown(model.get('rest_speed_fraction'))}")
     found = meta.get("versions")
     versions = ", ".join(
@@ -84,9 +79,9 @@ def run_lines(meta: dict[str, Any]) -> list[str]:
     return lines
 
 
-def scene_line(scenes: SceneBatch, plate_labels: tuple[str, ...]) -> str:
+def scene_line(scenes: SceneBatch, plate_labels: tuple[str, ...], registry: PluginRegistry) -> str:
     """Each scene column: its one value, its few values, or its range [user units]."""
-    declared = {**CORE_COLUMNS, **default_registry().plate_constants}
+    declared = {**CORE_COLUMNS, **registry.plate_constants}
     columns = scenes.columns
     parts = [f"plates {', '.join(shown(label) for label in dict.fromkeys(plate_labels))}"]
     for name in sorted(columns, key=lambda n: (n not in CORE_COLUMNS, n)):
@@ -97,18 +92,19 @@ def scene_line(scenes: SceneBatch, plate_labels: tuple[str, ...]) -> str:
     return "  scenes: " + "; ".join(parts)
 
 
-def run_description(archive: Archive, name: str) -> list[str]:
-    """What ``show`` prints of the run ``name`` (STUDY/RUN)."""
+def run_description(archive: Archive, name: str, registry: PluginRegistry) -> list[str]:
+    """What ``show`` prints of the run ``name`` (STUDY/RUN), settings and scene columns
+    as the plug-ins of ``registry`` declare them."""
     meta: dict[str, Any] = archive.metadata(name)
     result: BatchResult = archive.results(name)
     counts = np.bincount(result.outcome, minlength=4)[1:]
     from ..provenance.code import summary  # noqa: PLC0415 (hashing only here)
 
-    lines = [shown(name, None), *run_lines(meta)]
+    lines = [shown(name, None), *run_lines(meta, registry)]
     # each plug-in's origin and source hash (printable already)
     lines += [f"  {line}" for line in summary(meta.get("plugins"))]
     study = archive.study(name.split("/", 1)[0])
-    lines.append(scene_line(study.scenes, study.plate_labels))
+    lines.append(scene_line(study.scenes, study.plate_labels, registry))
     lines.append(
         f"  {len(result)} scenes: {counts[0]} ricochet, {counts[1]} embedment, "
         f"{counts[2]} perforation; wall {seconds(meta.get('wall_time_s'))}"

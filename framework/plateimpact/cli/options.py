@@ -22,7 +22,7 @@ from ..base.untrusted import load_json
 from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
 from ..model.impact import REST_SPEED_FRACTION, ImpactModel
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
-from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
+from ..registry.plugin_registry import KINDS, PluginRegistry
 from ..run.simulation import Simulation
 from ..storage.plate_file import load_plate_file
 from .common import UsageError
@@ -223,8 +223,9 @@ class ModelChoice:
         )
 
 
-def model_choice(args: argparse.Namespace) -> ModelChoice:
-    return ModelChoice(args, default_registry())
+def model_choice(args: argparse.Namespace, registry: PluginRegistry) -> ModelChoice:
+    """What the model options of ``args`` ask for, of the plug-ins of ``registry``."""
+    return ModelChoice(args, registry)
 
 
 def sphere_of(args: argparse.Namespace, registry: PluginRegistry) -> Sphere:
@@ -317,12 +318,15 @@ def scene_flags(args: argparse.Namespace, speed_flag: str, obliquity_flag: str) 
     typed(args).update({IMPACT_SPEED.name: speed_flag, IMPACT_OBLIQUITY.name: obliquity_flag})
 
 
-def flag_of(args: argparse.Namespace, parameter: str) -> str | None:
-    """The flag that set ``parameter``: as typed, or the one its declaration names."""
+def flag_of(
+    args: argparse.Namespace, parameter: str, registry: PluginRegistry | None
+) -> str | None:
+    """The flag that set ``parameter``: as typed, or the one its declaration names (a
+    core quantity's, or a plate constant's of ``registry``)."""
     if parameter in typed(args):
         return typed(args)[parameter]
-    registry = default_registry()
-    declared = {p.name: p for p in (THICKNESS, RADIUS, MASS)} | registry.plate_constants
+    constants = {} if registry is None else registry.plate_constants
+    declared = {p.name: p for p in (THICKNESS, RADIUS, MASS)} | constants
     if parameter in declared:
         return declared[parameter].flag
     return None

@@ -11,7 +11,6 @@ from __future__ import annotations
 import datetime as dt
 import os
 import shlex
-import sys
 import tempfile
 import traceback
 from collections.abc import Sequence
@@ -20,8 +19,7 @@ from typing import Protocol, TextIO
 
 from ..base.errors import PlateImpactWarning
 from ..base.untrusted import printable
-from ..provenance.metadata import versions
-from ..registry.discovery import first_line
+from .writer import Writer
 
 
 class ShowWarning(Protocol):
@@ -38,9 +36,9 @@ class ShowWarning(Protocol):
     ) -> None: ...
 
 
-def one_line_warnings(shown_before: ShowWarning) -> ShowWarning:
-    """A ``warnings.showwarning`` for the command: plateimpact's warnings as one line,
-    the rest (numpy's, a library's) passed to ``shown_before``."""
+def one_line_warnings(shown_before: ShowWarning, out: Writer) -> ShowWarning:
+    """A ``warnings.showwarning`` for the command: plateimpact's warnings as one line
+    through ``out``, the rest (numpy's, a library's) passed to ``shown_before``."""
 
     def show(
         message: Warning | str,
@@ -51,7 +49,7 @@ def one_line_warnings(shown_before: ShowWarning) -> ShowWarning:
         line: str | None = None,
     ) -> None:
         if issubclass(category, PlateImpactWarning):
-            print(f"plateimpact: warning: {printable(message)}", file=file or sys.stderr)
+            out.line_to_stderr(f"plateimpact: warning: {message}", file)
         else:
             shown_before(message, category, filename, lineno, file, line)
 
@@ -68,6 +66,9 @@ def traceback_directories() -> list[Path]:
 
 def write_traceback(exc: BaseException, argv: Sequence[str]) -> Path:
     """The full traceback of ``exc``, with the command line and versions, in a new file."""
+    from ..provenance.metadata import versions  # noqa: PLC0415 (only on a bug)
+    from ..registry.discovery import first_line  # noqa: PLC0415
+
     try:
         found = ", ".join(f"{name} {version}" for name, version in versions().items())
     except Exception:  # the report must not fail on what it only adds
@@ -90,11 +91,13 @@ def write_traceback(exc: BaseException, argv: Sequence[str]) -> Path:
     raise OSError("; ".join(failures))
 
 
-def report_internal_error(exc: Exception, argv: Sequence[str]) -> int:
+def report_internal_error(exc: Exception, argv: Sequence[str], out: Writer) -> int:
     """Print the one line of an internal error; the exit code (1)."""
+    from ..registry.discovery import first_line  # noqa: PLC0415 (only on a bug)
+
     try:
         where = f"the traceback is in {write_traceback(exc, argv)}"
     except OSError as error:
         where = f"the traceback could not be written ({error}); run with --debug to see it"
-    print(f"plateimpact: internal error: {printable(first_line(exc))}; {where}", file=sys.stderr)
+    out.line_to_stderr(f"plateimpact: internal error: {printable(first_line(exc))}; {where}")
     return 1

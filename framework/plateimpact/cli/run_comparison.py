@@ -5,22 +5,18 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
-
 from ..comparison import Comparison, ComparisonRow, OutcomeRange, Spread
-from ..limits.lines import SPEED
-from .common import say
-from .describe import shown
+from ..limits.lines import OBLIQUITY, SPEED
+from .formatting import ANGLE, AXES, IMPACT_SPEED, number, quantity, shown, unit
+from .writer import Writer
 
 
 def _place(axis: str, start: float, end: float) -> str:
     """``400-1500 m/s`` along speed, ``10-85 deg`` along obliquity (one value if equal)."""
-    if axis == SPEED:
-        values, unit = (start, end), "m/s"
-    else:
-        values, unit = (float(np.degrees(start)), float(np.degrees(end))), "deg"
-    texts = [f"{v:.6g}" for v in values]
-    return f"{texts[0]} {unit}" if texts[0] == texts[1] else f"{texts[0]}-{texts[1]} {unit}"
+    declared = AXES[axis]
+    texts = [number(declared, v) for v in (start, end)]
+    where = texts[0] if texts[0] == texts[1] else f"{texts[0]}-{texts[1]}"
+    return f"{where} {unit(declared)}"
 
 
 def _count(count: int, thing: str) -> str:
@@ -44,14 +40,15 @@ def _spread(spread: Spread) -> str:
     speed, obliquity = spread.max_abs_exit_speed_change, spread.max_abs_exit_obliquity_change
     if speed is None:
         return "no scenes"
-    text = f"exit speed differs by up to {speed:.1f} m/s"
+    text = f"exit speed differs by up to {quantity(IMPACT_SPEED, speed, 1, 'f')}"
     if obliquity is None:
         return f"{text} (embedded: no exit obliquity)"
-    return f"{text}, exit obliquity by up to {np.degrees(obliquity):.1f} deg"
+    return f"{text}, exit obliquity by up to {quantity(ANGLE, obliquity, 1, 'f')}"
 
 
 def _row_head(row: ComparisonRow) -> str:
-    at = f"{float(np.degrees(row.fixed)):.6g} deg" if row.axis == SPEED else f"{row.fixed:.6g} m/s"
+    other = AXES[OBLIQUITY if row.axis == SPEED else SPEED]
+    at = quantity(other, row.fixed)
     return f"{shown(row.plate)} at {at}, {_place(row.axis, row.start, row.end)}"
 
 
@@ -91,11 +88,11 @@ def summary_text(comparison: Comparison) -> str:
     return "\n".join(out)
 
 
-def print_comparison(comparison: Comparison, *, as_json: bool, summary: bool) -> None:
+def print_comparison(comparison: Comparison, out: Writer, *, as_json: bool, summary: bool) -> None:
     """Print the comparison: ranges as text, or counts only, or one JSON object."""
     if as_json:
         runs = {"a": comparison.run_a, "b": comparison.run_b}
         found = {**runs, **comparison.summary()} if summary else comparison.to_json()
-        say(json.dumps(found, indent=2))
+        out.say(json.dumps(found, indent=2))
     else:
-        say(summary_text(comparison) if summary else text(comparison))
+        out.say(summary_text(comparison) if summary else text(comparison))

@@ -8,15 +8,22 @@ import math
 from ..base.errors import UnknownNameError
 from ..limits import LimitsComparison, OutcomeMap, compare_limits, read_limits
 from ..limits.archived import KIND_MAP, NAMES, attributes_of
-from ..limits.compare import user
 from ..limits.lines import OBLIQUITY, SPEED, LimitLine
 from ..provenance.code import summary as code_summary
 from ..storage.archive import Archive
 from ..storage.records import LIMITS
-from .common import UsageError, say
+from .common import UsageError
 from .describe import seconds, shown
+from .formatting import AXES, unit
+from .writer import Writer
 
-_UNIT = {SPEED: "m/s", OBLIQUITY: "deg"}
+#: Each axis's unit as printed, from its declaration.
+_UNIT = {axis: unit(declared) for axis, declared in AXES.items()}
+
+
+def user(axis: str, value: float) -> float:
+    """``value`` [SI] on ``axis`` in the unit its declaration prints it in."""
+    return value / AXES[axis].scale
 
 
 def _digits(axis: str, tolerance: float) -> int:
@@ -31,7 +38,7 @@ def _value(axis: str, value: float | None, digits: int) -> str:
 def _fixed(axis: str, fixed: float) -> str:
     """A line's fixed coordinate, as ``obliquity 45 deg`` or ``speed 600 m/s``."""
     if axis == SPEED:
-        return f"obliquity {user(OBLIQUITY, fixed):g} deg"
+        return f"obliquity {user(OBLIQUITY, fixed):g} {_UNIT[OBLIQUITY]}"
     return f"speed {fixed:g} m/s"
 
 
@@ -80,7 +87,7 @@ def _plate(plate: object) -> str:
     )
 
 
-def show_stored(archive: Archive) -> None:
+def show_stored(archive: Archive, out: Writer) -> None:
     """Print every stored limits and map: what, plate, model, tolerance and resolution,
     then one line per line with its named limits. Every piece of the archive's text is
     printed inert (describe.shown)."""
@@ -116,7 +123,7 @@ def show_stored(archive: Archive) -> None:
             f"{shown(version)}, commit {shown(str(meta.get('git_commit'))[:12])}",
             *(f"  {line}" for line in code_summary(meta.get("plugins"))),
         ]
-        say("\n".join(lines))
+        out.say("\n".join(lines))
 
 
 def _is_stored(name: str, stored: list[str]) -> bool:
@@ -196,7 +203,7 @@ def _text(name_a: str, name_b: str, comparison: LimitsComparison) -> str:
     return "\n".join(out)
 
 
-def compare_stored(archive: Archive, name_a: str, name_b: str, as_json: bool) -> None:
+def compare_stored(archive: Archive, name_a: str, name_b: str, as_json: bool, out: Writer) -> None:
     """Print how each boundary moved from stored limits ``name_a`` to ``name_b``."""
     a, b = read_limits(archive, name_a), read_limits(archive, name_b)
     axis_a, axis_b = (x.limits.axis if isinstance(x, OutcomeMap) else x.axis for x in (a, b))
@@ -207,6 +214,6 @@ def compare_stored(archive: Archive, name_a: str, name_b: str, as_json: bool) ->
         )
     comparison = compare_limits(a, b)
     if as_json:
-        say(json.dumps({"a": name_a, "b": name_b, **comparison.to_json()}, indent=2))
+        out.say(json.dumps({"a": name_a, "b": name_b, **comparison.to_json()}, indent=2))
         return
-    say(_text(name_a, name_b, comparison))
+    out.say(_text(name_a, name_b, comparison))

@@ -36,6 +36,7 @@ from ..limits.plate_limits import check_steps
 from ..model.bodies import MASS, RADIUS, Plate, Sphere
 from ..model.results import Outcome
 from ..model.scene import IMPACT_SPEED
+from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
 from ..storage.shots import Shots
@@ -132,6 +133,8 @@ class ValidationReport:
     disagreements: tuple[Disagreement, ...]
     speeds: tuple[float, float]
     limits: tuple[Limits, ...]
+    #: The simulation's plug-ins: the declarations of the plate's constants.
+    registry: PluginRegistry = attrs.field(kw_only=True, repr=False)
 
     def to_json(self) -> dict[str, Any]:
         """One object in user units; null where no pair exists (never NaN)."""
@@ -148,7 +151,11 @@ class ValidationReport:
             "exit_obliquity_pairs": int(np.isfinite(self.exit_obliquity_error).sum()),
             "disagreements": [d.to_json() for d in self.disagreements],
             "boundary_speeds_m_s": list(self.speeds),
-            "plate": {k: v for k, v in plate_to_dict(self.plate).items() if k != "format"},
+            "plate": {
+                k: v
+                for k, v in plate_to_dict(self.plate, registry=self.registry).items()
+                if k != "format"
+            },
             "sphere": {
                 RADIUS.key: self.sphere.radius / RADIUS.scale,
                 MASS.key: self.sphere.mass / MASS.scale,
@@ -375,4 +382,5 @@ def validate(
         disagreements=disagreements,
         speeds=speeds,
         limits=limits,
+        registry=simulation.registry,
     )

@@ -22,10 +22,10 @@ from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
 from ..provenance.metadata import git_commit, versions
-from ..registry.plugin_registry import default_registry
+from ..registry.plugin_registry import PluginRegistry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
-from ..storage.plate_file import plate_to_dict
+from ..storage.plate_file import FORMAT as PLATE_FORMAT
 from ..storage.records import Record, RecordColumn
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
@@ -128,8 +128,10 @@ def _axis_columns(limits: Limits) -> dict[str, RecordColumn]:
     return columns
 
 
-def _body_columns(sphere: Sphere, plate: Plate) -> dict[str, RecordColumn]:
-    declared = default_registry().plate_constants
+def _body_columns(
+    sphere: Sphere, plate: Plate, registry: PluginRegistry
+) -> dict[str, RecordColumn]:
+    declared = registry.plate_constants
     columns = {}
     for where, parameter, value in [
         ("sphere/radius", RADIUS, sphere.radius),
@@ -150,7 +152,7 @@ def to_record(found: Limits | OutcomeMap) -> Record:
     unit = UNITS[limits.axis]
     kind = KIND_MAP if isinstance(found, OutcomeMap) else KIND_LIMITS
     what = "outcome map" if kind == KIND_MAP else f"limits along {NAMES[limits.axis]}"
-    plate = plate_to_dict(limits.plate)
+    plate = {"format": PLATE_FORMAT, **limits.plate_record()}
     attributes: dict[str, object] = {
         "kind": kind,
         "description": f"{what} of {plate['material']} {plate[THICKNESS.key]:g} mm; "
@@ -174,7 +176,8 @@ def to_record(found: Limits | OutcomeMap) -> Record:
     }
     if limits.plugins is not None:  # the code that found them (docs/archive.md, Provenance)
         attributes["plugins"] = json.dumps(limits.plugins, sort_keys=True)
-    columns = _body_columns(limits.sphere, limits.plate) | _axis_columns(limits)
+    assert limits.registry is not None  # plate_record refused it otherwise
+    columns = _body_columns(limits.sphere, limits.plate, limits.registry) | _axis_columns(limits)
     if isinstance(found, OutcomeMap):
         columns |= {
             "map/speeds": RecordColumn(found.speeds, "m/s", "impact speed", "the grid's columns"),
@@ -212,10 +215,13 @@ def _number(attributes: dict[str, object], key: str) -> float:
     return float(value)
 
 
-def from_record(record: Record, what: str = "stored limits") -> Limits | OutcomeMap:
+def from_record(
+    record: Record, what: str = "stored limits", registry: PluginRegistry | None = None
+) -> Limits | OutcomeMap:
     """The limits or map a record holds (ValueError, KeyError or TypeError if it is
     not one; ArchiveError naming ``what`` for an attribute of the wrong type: they come
-    from a file, maybe someone else's)."""
+    from a file, maybe someone else's); ``registry`` describes their plate when they
+    are written again (Limits.plate_record)."""
     attributes, columns = record.attributes, record.columns
 
     def data(where: str) -> np.ndarray:
@@ -261,6 +267,7 @@ def from_record(record: Record, what: str = "stored limits") -> Limits | Outcome
         int(_number(attributes, "passes")),
         _number(attributes, "wall_time_s"),
         _plugins(attributes, what),
+        registry=registry,
     )
     if kind == KIND_LIMITS:
         return limits
@@ -300,15 +307,18 @@ def archive_limits(
     return _archive(archive).append_record(name, to_record(found), overwrite=overwrite)
 
 
-def read_limits(archive: Archive | str | os.PathLike[str], name: str) -> Limits | OutcomeMap:
+def read_limits(
+    archive: Archive | str | os.PathLike[str], name: str, registry: PluginRegistry | None = None
+) -> Limits | OutcomeMap:
     """The limits or map stored as ``name`` (``NAME`` or ``limits/NAME``), as written;
     ArchiveError if the archive or the record is damaged, UnknownNameError if there is
-    no such name (the message lists those there are)."""
+    no such name (the message lists those there are). With ``registry`` (its plate
+    constants' declarations) they can be printed as JSON or stored again."""
     where = _archive(archive)
     record = where.record(name)
     what = f"archive {where.path}: limits {printable(name)}"
     try:
-        return from_record(record, what)
+        return from_record(record, what, registry)
     except ArchiveError:
         raise
     except (KeyError, ValueError, TypeError, IndexError, AttributeError, PlateImpactError) as exc:

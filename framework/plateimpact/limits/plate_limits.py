@@ -16,7 +16,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..base.errors import ParameterError, WorkBoundError
+from ..base.errors import ParameterError, PluginError, WorkBoundError
 from ..base.parameters import check_instance
 from ..model.batch import SceneBatch
 from ..model.bodies import MASS, RADIUS, Plate, Sphere
@@ -24,6 +24,7 @@ from ..model.results import BatchResult
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..provenance.code import limits_record, plugins_record
 from ..provenance.metadata import source_commit, versions
+from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
 from .bracketing import GROUP_SCENES, RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
@@ -66,13 +67,26 @@ class Limits:
     passes: int
     seconds: float
     plugins: dict[str, Any] | None = None
+    #: The plug-ins of the simulation that found them: the declarations of the plate's
+    #: constants (None when read back without one: then no plate record can be written).
+    registry: PluginRegistry | None = attrs.field(default=None, kw_only=True, repr=False)
+
+    def plate_record(self) -> dict[str, Any]:
+        """The plate as a plate file holds it (storage.plate_file), without its format."""
+        if self.registry is None:
+            raise PluginError(
+                "these limits carry no plug-in registry to describe their plate with: read "
+                "them with read_limits(..., registry=...)"
+            )
+        record = plate_to_dict(self.plate, registry=self.registry)
+        return {k: v for k, v in record.items() if k != "format"}
 
     def to_json(self) -> dict[str, Any]:
         """One object in user units (``plateimpact limits --json``)."""
         unit = unit_suffix(self.axis)
         scale = _DEG if self.axis == OBLIQUITY else 1.0
         return {
-            "plate": {k: v for k, v in plate_to_dict(self.plate).items() if k != "format"},
+            "plate": self.plate_record(),
             "sphere": {
                 RADIUS.key: self.sphere.radius / RADIUS.scale,
                 MASS.key: self.sphere.mass / MASS.scale,
@@ -236,6 +250,7 @@ def _find(
             found.passes,
             seconds,
             plugins,
+            registry=simulation.registry,
         )  # fmt: skip
         for k, plate in enumerate(plates)
     ]

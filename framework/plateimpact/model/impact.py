@@ -8,15 +8,25 @@ from typing import Any, ClassVar
 import attrs
 import numpy as np
 
-from ..base.errors import ParameterError, PluginError
+from ..base.errors import PluginError
 from ..base.parameters import Parameter, Range
-from .batch import CORE_COLUMNS, SceneBatch
-from .binding import BoundBatch
-from .failure import FailureModel
+from .batch import SceneBatch
+from .binding import BoundBatch, bind_scenes, check_declarations
+from .events import (
+    AT_REST,
+    CONTACT_LOST,
+    EVENTS,
+    FAILURE_EVENTS,
+    FAILURE_ONSET,
+    ONSET,
+    PERFORATED,
+    PERFORATION,
+    TURNED_BACK,
+)
+from .failure import Contact, FailureModel
 from .geometry import branch_margins, contact_lost_margin
 from .plugin import Plugin
 from .resistance import BoundResistance, ResistanceLaw, contact_force
-from .results import Outcome
 
 # At 1e-6 Vs a sphere has 1e-12 of its energy left; below, the rule would only chase
 # dθ/dt = lift/(m V), which grows without bound as V falls.
@@ -26,29 +36,11 @@ REST_SPEED_FRACTION = Parameter(
     range=Range(1e-6, 1.0, high_open=True),
     default=1e-2,
 )
-ONSET_PENETRATION = Parameter(
-    "onset_penetration",
-    "penetration at which the plate fails (the failure model's; inf: never)",
-    "m",
-    Range(0.0, low_open=True, allow_inf=True),
-    "mm",
-    1e-3,
-)
 
 #: Rows of the state vector y used by ODE integrators: P [m], Y [m], θ [rad], V [m/s],
 #: then the failure model's state variables.
 PENETRATION, LATERAL, OBLIQUITY, SPEED = range(4)
 KINEMATIC_STATE = 4
-
-#: Rows of :meth:`ImpactModel.event_margins`. Each margin crosses zero upward at its event.
-ONSET, CONTACT_LOST, PERFORATED, AT_REST, TURNED_BACK = range(5)
-EVENT_NAMES = ("failure onset", "contact lost", "perforated", "at rest", "turned back")
-#: The events that end an impact, and the outcome each one means.
-EVENT_OUTCOMES = {
-    CONTACT_LOST: Outcome.RICOCHET,
-    PERFORATED: Outcome.PERFORATION,
-    AT_REST: Outcome.EMBEDMENT,
-}
 
 
 def _plugin_of(kind: type) -> Any:
@@ -92,6 +84,12 @@ class ImpactModel:
 
     def __attrs_post_init__(self) -> None:
         check_declarations(dict(self.plugins()))
+        foreign = [e.name for e in self.failure.events if e not in FAILURE_EVENTS]
+        if foreign:
+            raise PluginError(
+                f"failure {self.failure.name!r} declares event {foreign[0]!r}; a failure "
+                f"model adds only {', '.join(e.name for e in FAILURE_EVENTS)}"
+            )
 
     def plugins(self) -> Iterator[tuple[str, Plugin]]:
         """(slot, plug-in) for each slot that sees the batch."""
@@ -102,45 +100,44 @@ class ImpactModel:
         """Every plate constant the model reads, by name."""
         return {p.name: p for _, plugin in self.plugins() for p in plugin.plate_constants}
 
-    # -- binding ---------------------------------------------------------------------
-
     def bind(self, batch: SceneBatch) -> BoundBatch:
-        """The batch with every per-scene constant the step loop needs, computed once and
-        namespaced: the plate constants each plug-in declared (checked against their
-        ranges, or their defaults where the plate has none), the columns each prepared,
-        ``onset_penetration`` [m] and ``rest_speed`` [m/s]."""
-        n = batch.size
-        given = batch.columns
-        columns = {name: given[name] for name in CORE_COLUMNS}
-        keys: dict[str, dict[str, str]] = {}
-        for slot, plugin in self.plugins():
-            visible = {name: name for name in CORE_COLUMNS}
-            for declared in plugin.plate_constants:
-                if declared.name not in columns:
-                    columns[declared.name] = _constant_column(declared, given, n, slot, plugin)
-                visible[declared.name] = declared.name
-            view = SceneBatch.of({k: columns[v] for k, v in visible.items()}, n)
-            prepared = plugin.prepare(view)  # type: ignore[attr-defined]
-            for name, values in _checked_columns(slot, plugin, prepared, n).items():
-                columns[f"{slot}.{name}"] = values
-                visible[name] = f"{slot}.{name}"
-            keys[slot] = visible
-        failure_view = SceneBatch.of({k: columns[v] for k, v in keys["failure"].items()}, n)
-        onset = np.broadcast_to(
-            np.asarray(self.failure.onset_penetration(failure_view), dtype=float), (n,)
-        )
-        ONSET_PENETRATION.check(onset)
-        columns["onset_penetration"] = np.ascontiguousarray(onset)
-        columns["rest_speed"] = self.rest_speed_fraction * given["impact_speed"]
-        keys["core"] = {name: name for name in (*CORE_COLUMNS, "onset_penetration", "rest_speed")}
-        return BoundBatch(columns, keys, n)
+        """The batch with every per-scene constant the step loop needs
+        (:func:`~plateimpact.model.binding.bind_scenes`), computed once."""
+        plugins = list(self.plugins())
+        return bind_scenes(plugins, self.failure.onset_penetration, self.rest_speed_fraction, batch)
 
     def new_failure_state(self, size: int) -> np.ndarray:
-        """Failure-state array for ``size`` scenes, shape (len(state_names), size).
+        """Failure-state array for ``size`` scenes, shape (len(state_names), size): zero
+        until :meth:`start_failure` sets it (the driver integrates those zeros unchanged,
+        since the rates of an intact scene's failure state are zero)."""
+        return np.zeros((len(self.failure.state_names), size))
 
-        NaN until :meth:`start_failure` sets it: before failure it means nothing.
-        """
-        return np.full((len(self.failure.state_names), size), np.nan)
+    def _contact(
+        self,
+        index: np.ndarray | None,
+        penetration: np.ndarray,
+        obliquity: np.ndarray,
+        speed: np.ndarray,
+        failure_state: np.ndarray,
+        batch: BoundBatch,
+        obliquity_rate: np.ndarray | None = None,
+    ) -> Contact:
+        """The :class:`Contact` of the scenes at ``index`` (None: all of them)."""
+        if index is None:
+            law = BoundResistance(self.resistance, batch.resistance)
+            return Contact(
+                penetration, obliquity, speed, failure_state, batch.failure, law, obliquity_rate
+            )
+        law = BoundResistance(self.resistance, batch.resistance.take(index))
+        return Contact(
+            penetration[index],
+            obliquity[index],
+            speed[index],
+            failure_state[:, index],
+            batch.failure.take(index),
+            law,
+            None if obliquity_rate is None else obliquity_rate[index],
+        )
 
     # -- forces and rates --------------------------------------------------------------
 
@@ -162,28 +159,15 @@ class ImpactModel:
         """
         side = np.where(obliquity < 0.0, -1.0, 1.0)
         obliquity = np.abs(obliquity)
-        law = batch.resistance
-        drag, lift = contact_force(self.resistance, penetration, obliquity, speed, law)
+        drag, lift = contact_force(self.resistance, penetration, obliquity, speed, batch.resistance)
         if failed.all():  # no subset to take: every scene has failed
-            extra_drag, extra_lift = self.failure.force_change(
-                penetration,
-                obliquity,
-                speed,
-                failure_state,
-                batch.failure,
-                BoundResistance(self.resistance, law),
-            )
+            contact = self._contact(None, penetration, obliquity, speed, failure_state, batch)
+            extra_drag, extra_lift = self.failure.force_change(contact)
             return drag + extra_drag, side * (lift + extra_lift)
         if failed.any():
             index = np.flatnonzero(failed)
-            extra_drag, extra_lift = self.failure.force_change(
-                penetration[index],
-                obliquity[index],
-                speed[index],
-                failure_state[:, index],
-                batch.failure.take(index),
-                BoundResistance(self.resistance, law.take(index)),
-            )
+            contact = self._contact(index, penetration, obliquity, speed, failure_state, batch)
+            extra_drag, extra_lift = self.failure.force_change(contact)
             drag[index] += extra_drag
             lift[index] += extra_lift
         return drag, side * lift
@@ -200,9 +184,8 @@ class ImpactModel:
         """Set the failure state of the scenes in the boolean mask ``onset`` (in place)."""
         if failure_state.shape[0] and onset.any():
             index = np.flatnonzero(onset)
-            failure_state[:, index] = self.failure.initial_state(
-                penetration[index], obliquity[index], speed[index], batch.failure.take(index)
-            )
+            contact = self._contact(index, penetration, obliquity, speed, failure_state, batch)
+            failure_state[:, index] = self.failure.initial_state(contact)
 
     def failure_state_rates(
         self,
@@ -218,14 +201,10 @@ class ImpactModel:
         rates = np.zeros_like(failure_state)
         if failure_state.shape[0] and failed.any():
             index = np.flatnonzero(failed)
-            rates[:, index] = self.failure.state_rates(
-                penetration[index],
-                obliquity[index],
-                speed[index],
-                obliquity_rate[index],
-                failure_state[:, index],
-                batch.failure.take(index),
+            contact = self._contact(
+                index, penetration, obliquity, speed, failure_state, batch, obliquity_rate
             )
+            rates[:, index] = self.failure.state_rates(contact)
         return rates
 
     def rates(
@@ -261,33 +240,48 @@ class ImpactModel:
         batch: BoundBatch,
         kinds: frozenset[int] | None = None,
     ) -> np.ndarray:
-        """Event functions, shape (5, n), rows :data:`ONSET` ... :data:`TURNED_BACK`: the
-        one definition of the outcome rules.
+        """Event functions, shape (len(EVENTS), n), one row per declared event
+        (:data:`~plateimpact.model.events.EVENTS`): the one definition of the outcome rules.
 
         Each crosses zero upward at its event and is −inf where the event cannot happen:
         failure onset (P − P*, intact plates), contact lost (θ − π/2 − α1), perforation
         (the failure model's margin, failed plates, while θ < π/2), rest (V_rest − V),
-        turned back (θ − π + TURN_BACK_TOLERANCE, not yet held). Where two are reached at
-        one point, the lower row wins: perforation over ricochet over embedment.
-        ``kinds``: compute only these rows (the others are NaN), as root finding needs.
+        turned back (θ − π + TURN_BACK_TOLERANCE, not yet held). A failure event the
+        failure model does not declare is −inf throughout. Where two are reached at one
+        point, the lower row wins: perforation over ricochet over embedment. ``kinds``:
+        compute only these rows (the others are NaN), as root finding needs.
         """
         pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
         core = batch.core
-        every = kinds is None
-        margins = np.full((5, pen.size), np.nan) if not every else np.empty((5, pen.size))
-        if every or ONSET in kinds:  # type: ignore[operator]
-            margins[ONSET] = np.where(failed, -np.inf, pen - core.onset_penetration)
-        if every or CONTACT_LOST in kinds:  # type: ignore[operator]
+        wanted = range(len(EVENTS)) if kinds is None else kinds
+        margins = np.full((len(EVENTS), pen.size), np.nan)
+        added = self.failure.events
+        if ONSET in wanted:
+            margins[ONSET] = (
+                np.where(failed, -np.inf, pen - core.onset_penetration)
+                if FAILURE_ONSET in added
+                else -np.inf
+            )
+        if CONTACT_LOST in wanted:
             margins[CONTACT_LOST] = contact_lost_margin(pen, obl, core.radius)
-        if every or PERFORATED in kinds:  # type: ignore[operator]
-            margins[PERFORATED] = self._inward_perforation_margin(pen, obl, failed, batch)
-        if every or AT_REST in kinds:  # type: ignore[operator]
-            margins[AT_REST] = core.rest_speed - y[SPEED]
-        if every or TURNED_BACK in kinds:  # type: ignore[operator]
+        if PERFORATED in wanted:
+            margins[PERFORATED] = (
+                self._inward_perforation_margin(y, obl, failed, batch)
+                if PERFORATION in added
+                else -np.inf
+            )
+        if AT_REST in wanted:
+            margins[AT_REST] = self.rest_margin(y[SPEED], batch)
+        if TURNED_BACK in wanted:
             margins[TURNED_BACK] = np.where(
                 held, -np.inf, obl - (self.MAX_OBLIQUITY - self.TURN_BACK_TOLERANCE)
             )
         return margins
+
+    @staticmethod
+    def rest_margin(speed: np.ndarray, batch: BoundBatch) -> np.ndarray:
+        """V_rest − V [m/s]: >= 0 where the sphere is at rest (the embedment rule)."""
+        return batch.core.rest_speed - speed
 
     def branch_margins(self, y: np.ndarray, failed: np.ndarray, batch: BoundBatch) -> np.ndarray:
         """Margins that cross zero where the force changes formula, shape (rows, n): the
@@ -302,99 +296,47 @@ class ImpactModel:
         if not failed.any():
             return rows
         index = np.flatnonzero(failed)
-        failure_rows = self.failure.branch_margins(
-            pen[index], obl[index], y[KINEMATIC_STATE:, index], batch.failure.take(index)
-        )
+        contact = self._contact(index, pen, obl, y[SPEED], y[KINEMATIC_STATE:], batch)
+        failure_rows = self.failure.branch_margins(contact)
         extra = np.full((failure_rows.shape[0], pen.size), np.nan)
         extra[:, index] = failure_rows
         return np.concatenate([rows, extra])
 
     def perforation_margin(
-        self, penetration: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: BoundBatch
+        self, y: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
-        """>= 0 where perforation is complete [m]; −inf where the plate is intact."""
-        margin = np.full(penetration.shape, -np.inf)
+        """>= 0 where perforation is complete [m]; −inf where the plate is intact.
+        ``obliquity`` θ >= 0 [rad] (the mirror image of y's)."""
+        margin = np.full(obliquity.shape, -np.inf)
         if failed.any():
             index = np.flatnonzero(failed)
-            margin[index] = self.failure.perforation_margin(
-                penetration[index], np.abs(obliquity[index]), batch.failure.take(index)
-            )
+            pen, speed, state = y[PENETRATION], y[SPEED], y[KINEMATIC_STATE:]
+            contact = self._contact(index, pen, obliquity, speed, state, batch)
+            margin[index] = self.failure.perforation_margin(contact)
         return margin
 
     def _inward_perforation_margin(
-        self, penetration: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: BoundBatch
+        self, y: np.ndarray, obliquity: np.ndarray, failed: np.ndarray, batch: BoundBatch
     ) -> np.ndarray:
         """The perforation margin where it counts: only while the sphere moves inward
         (θ < 90°); −inf elsewhere and on intact plates."""
-        margin = self.perforation_margin(penetration, obliquity, failed, batch)
+        margin = self.perforation_margin(y, obliquity, failed, batch)
         return np.where(obliquity < 0.5 * np.pi, margin, -np.inf)
 
     def describe(self) -> dict[str, object]:
-        """Plug-in names, versions and settings, for output and archives."""
-        return {
-            "resistance": self.resistance.name,
-            "resistance_version": self.resistance.version,
-            "resistance_settings": self.resistance.settings(),
-            "failure": self.failure.name,
-            "failure_version": self.failure.version,
-            "failure_settings": self.failure.settings(),
-            "rest_speed_fraction": self.rest_speed_fraction,
-        }
+        """Each slot's plug-in name, version and settings, and the rest rule, for output
+        and archives (``SLOT``, ``SLOT_version``, ``SLOT_settings``)."""
+        described: dict[str, object] = {}
+        for slot, plugin in self.plugins():
+            described.update(describe_plugin(slot, plugin))
+        described["rest_speed_fraction"] = self.rest_speed_fraction
+        return described
 
 
-def check_declarations(plugins: dict[str, Any]) -> None:
-    """Refuse, with one line, plug-ins whose declarations clash: one plate constant
-    declared two ways, or a prepared column that shadows a core column or constant."""
-    seen: dict[str, tuple[Parameter, str]] = {}
-    for slot, plugin in plugins.items():
-        label = f"{slot} {plugin.name!r}"
-        for declared in plugin.plate_constants:
-            if declared.name in CORE_COLUMNS:
-                raise PluginError(
-                    f"{label} declares plate constant {declared.name!r}, a core column"
-                )
-            if declared.name in seen and seen[declared.name][0] != declared:
-                raise PluginError(
-                    f"{seen[declared.name][1]} and {label} both claim plate constant "
-                    f"{declared.name!r} with different declarations"
-                )
-            seen.setdefault(declared.name, (declared, label))
-        shadowed = {c.name for c in plugin.columns} & (
-            set(CORE_COLUMNS) | {p.name for p in plugin.plate_constants}
-        )
-        if shadowed:
-            raise PluginError(f"{label} prepares column {sorted(shadowed)[0]!r}, a name it reads")
-
-
-def _constant_column(
-    declared: Parameter, given: dict[str, np.ndarray], n: int, slot: str, plugin: Plugin
-) -> np.ndarray:
-    """The plate constant a plug-in declared: the plate's, checked, or its default."""
-    if declared.name in given:
-        declared.check(given[declared.name])
-        return given[declared.name]
-    if declared.has_default:
-        return np.full(n, float(declared.default))  # type: ignore[arg-type]
-    raise ParameterError(
-        declared.name,
-        f"{declared.name} ({declared.description}) is needed by {slot} {plugin.name!r} and "
-        f"has no default: give the plate one ({declared.describe_range()})",
-    )
-
-
-def _checked_columns(
-    slot: str, plugin: Plugin, prepared: dict[str, Any], n: int
-) -> dict[str, np.ndarray]:
-    """The columns a plug-in prepared, exactly those it declared, one float per scene."""
-    declared = [c.name for c in plugin.columns]
-    if set(prepared) != set(declared):
-        extra, missing = (
-            sorted(set(prepared) - set(declared)),
-            sorted(set(declared) - set(prepared)),
-        )
-        what = f"undeclared column {extra[0]!r}" if extra else f"no column {missing[0]!r}"
-        raise PluginError(f"{slot} {plugin.name!r}: prepare() returned {what}")
+def describe_plugin(slot: str, plugin: Plugin) -> dict[str, object]:
+    """``{SLOT: name, SLOT_version: version, SLOT_settings: settings}`` of one slot."""
     return {
-        name: np.ascontiguousarray(np.broadcast_to(np.asarray(prepared[name], float), (n,)))
-        for name in declared
+        slot: plugin.name,
+        f"{slot}_version": plugin.version,
+        f"{slot}_settings": plugin.settings(),
     }

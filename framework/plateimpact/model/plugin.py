@@ -12,8 +12,10 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import attrs
+import numpy as np
 
 from ..base.parameters import Parameter, declared_settings
+from .batch import SceneBatch
 
 
 @attrs.frozen
@@ -44,7 +46,7 @@ class Plugin:
         Two plug-ins may share a constant only through equal declarations (reuse the
         object, e.g. ``plateimpact_plugins.STRENGTH_A``).
     columns : tuple of Column
-        The per-scene columns its ``prepare`` returns.
+        The per-scene columns its :meth:`prepare` returns.
     """
 
     name: ClassVar[str]
@@ -64,3 +66,8 @@ class Plugin:
             name: declared.json_value(getattr(self, name))
             for name, declared in self.setting_declarations().items()
         }
+
+    def prepare(self, scenes: SceneBatch) -> dict[str, np.ndarray]:
+        """The per-scene columns declared in ``columns``, by name, computed once per batch
+        before any step from this plug-in's view of the scenes (default: none)."""
+        return {}

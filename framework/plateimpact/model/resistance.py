@@ -25,21 +25,17 @@ class ResistanceLaw(Plugin, ABC):
     scenes, no hook calls.
     """
 
-    def prepare(self, batch: SceneBatch) -> dict[str, np.ndarray]:
-        """The per-scene columns declared in ``columns``, computed once per batch before
-        any step (default none)."""
-        return {}
-
     @abstractmethod
-    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
-        """Stress on the presented area [N/m²].
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
+        """Stress on the presented area [N/m²]: a function of its arguments and the law's
+        settings alone.
 
         Parameters
         ----------
-        speed : V [m/s], one per scene of ``batch``.
+        speed : V [m/s], one per scene of ``scenes``.
         incidence : ψ [rad], the angle between the path and the force's line.
-        batch : this law's view of the scenes: the core columns, the plate constants it
-            declared (``batch.a``) and the columns it prepared.
+        scenes : this law's view of the scenes: the core columns, the plate constants it
+            declared (``scenes.a``) and the columns it prepared.
         """
 
 

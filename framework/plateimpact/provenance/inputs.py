@@ -35,7 +35,7 @@ from ..model.bodies import MASS, RADIUS, Sphere
 from ..model.impact import REST_SPEED_FRACTION
 from ..model.plugin import Plugin
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
-from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
+from ..registry.plugin_registry import KINDS, PluginRegistry
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_from_dict
 
@@ -154,11 +154,9 @@ def _settings(given: dict[str, Any], cls: type[Plugin], where: str) -> dict[str,
     return out
 
 
-def read_simulation(
-    data: Mapping[str, Any], where: str, registry: PluginRegistry | None = None
-) -> Simulation:
-    """The simulation of a model record (:func:`model_record`)."""
-    registry = registry or default_registry()
+def read_simulation(data: Mapping[str, Any], where: str, *, registry: PluginRegistry) -> Simulation:
+    """The simulation of a model record (:func:`model_record`), its plug-ins from
+    ``registry``."""
     known = {*KINDS, *(f"{k}_{part}" for k in KINDS for part in ("version", "settings"))}
     _no_unknown(data, known | _keys(REST_SPEED_FRACTION), where)
     names = {}
@@ -196,8 +194,9 @@ class RunInputs:
     label: str
 
 
-def read_run_inputs(data: object, source: str, registry: PluginRegistry | None = None) -> RunInputs:
-    """The scene and simulation of ``run --json``'s output or of its ``inputs`` object;
+def read_run_inputs(data: object, source: str, *, registry: PluginRegistry) -> RunInputs:
+    """The scene and simulation of ``run --json``'s output or of its ``inputs`` object,
+    plug-ins and plate keys from ``registry``;
     :class:`~plateimpact.base.errors.InputsError` names ``source`` and the key."""
     if isinstance(data, dict) and isinstance(data.get("inputs"), dict):
         data = data["inputs"]
@@ -217,8 +216,10 @@ def read_run_inputs(data: object, source: str, registry: PluginRegistry | None =
             radius=_read_quantity(sphere_data, RADIUS, f"{where}sphere."),
             mass=_read_quantity(sphere_data, MASS, f"{where}sphere."),
         )
-        plate = plate_from_dict(_object(data, "plate", where), f"{source}: plate", registry)
-        simulation = read_simulation(_object(data, "model", where), f"{where}model.", registry)
+        plate_data = _object(data, "plate", where)
+        plate = plate_from_dict(plate_data, f"{source}: plate", registry=registry)
+        model_data = _object(data, "model", where)
+        simulation = read_simulation(model_data, f"{where}model.", registry=registry)
         scene = Scene(
             sphere,
             plate,
@@ -231,9 +232,7 @@ def read_run_inputs(data: object, source: str, registry: PluginRegistry | None =
     return RunInputs(scene, simulation, label if isinstance(label, str) else source)
 
 
-def load_run_inputs(
-    path: str | os.PathLike[str], registry: PluginRegistry | None = None
-) -> RunInputs:
+def load_run_inputs(path: str | os.PathLike[str], *, registry: PluginRegistry) -> RunInputs:
     """The scene and simulation recorded in a file (``run --json``'s output)."""
     data = load_json_file(path, InputsError)  # bounded: nesting, digits, size, duplicates
-    return read_run_inputs(data, printable(os.fspath(path), 200), registry)
+    return read_run_inputs(data, printable(os.fspath(path), 200), registry=registry)

@@ -177,7 +177,7 @@ def inputs_record(
     if sphere is not None:
         record["sphere"] = inputs.sphere_record(sphere)
     if plate is not None:
-        record["plate"] = plate_to_dict(plate)
+        record["plate"] = plate_to_dict(plate, registry=simulation.registry)
     record["model"] = inputs.model_record(simulation)
     record["versions"] = versions()
     record["source_commit"] = source_commit()

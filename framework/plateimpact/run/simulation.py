@@ -13,7 +13,7 @@ from ..base.errors import ParameterError, PluginError
 from ..model.batch import SceneBatch, check_chunk_size
 from ..model.binding import BoundBatch
 from ..model.crater import crater_sections
-from ..model.impact import REST_SPEED_FRACTION, ImpactModel
+from ..model.impact import REST_SPEED_FRACTION, ImpactModel, describe_plugin
 from ..model.results import BatchResult, Result
 from ..model.scene import Scene
 from ..registry.plugin_registry import PluginRegistry, default_registry
@@ -32,16 +32,30 @@ def _integrator(instance: object, attribute: attrs.Attribute, value: object) -> 
         raise PluginError(f"integrator must be an Integrator, got {value!r}")
 
 
+def _registry(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    if not isinstance(value, PluginRegistry):
+        raise ParameterError("registry", f"registry must be a PluginRegistry, got {value!r:.80}")
+
+
 @attrs.frozen
 class Simulation:
     """Runs scenes through one resolved model and integrator.
 
     Build it from plug-in names with :meth:`from_names`, then call :meth:`run` for one
     scene or :meth:`run_batch` for many; the CLI does exactly this.
+
+    ``registry`` is where the plug-ins were found; what reads or writes a plate, a run's
+    inputs or stored limits for this simulation takes its declarations from there. A
+    Simulation is where the library resolves an omitted registry: without one, the
+    installed plug-ins (:func:`~plateimpact.default_registry`; docs/plugins.md, "Where
+    the registry comes from").
     """
 
     model: ImpactModel
     integrator: Integrator = attrs.field(validator=_integrator)
+    registry: PluginRegistry = attrs.field(
+        factory=default_registry, kw_only=True, eq=False, repr=False, validator=_registry
+    )
 
     @classmethod
     def from_names(
@@ -58,7 +72,7 @@ class Simulation:
     ) -> Simulation:
         """Resolve each slot by name from ``registry`` (default: installed plug-ins); a
         slot not named takes the registry's default plug-in of its kind."""
-        registry = registry or default_registry()
+        registry = default_registry() if registry is None else registry
         if not isinstance(registry, PluginRegistry):
             raise ParameterError("registry", f"registry must be a PluginRegistry, got {registry!r}")
         resistance = registry.default("resistance") if resistance is None else resistance
@@ -79,7 +93,7 @@ class Simulation:
             rest_speed_fraction=rest_speed_fraction,
         )
         settings = _settings("integrator", integrator_settings)
-        return cls(model, registry.create("integrator", integrator, **settings))
+        return cls(model, registry.create("integrator", integrator, **settings), registry=registry)
 
     def run_batch(
         self,
@@ -118,13 +132,9 @@ class Simulation:
         return self.run_batch([scene], record_trajectory=record_trajectory).result(0)
 
     def describe(self) -> dict[str, object]:
-        """Plug-in names, versions and settings."""
-        return {
-            **self.model.describe(),
-            "integrator": self.integrator.name,
-            "integrator_version": self.integrator.version,
-            "integrator_settings": self.integrator.settings(),
-        }
+        """Each slot's plug-in name, version and settings (the model's, then the
+        integrator's), and the rest rule."""
+        return {**self.model.describe(), **describe_plugin("integrator", self.integrator)}
 
 
 def _settings(kind: str, settings: object) -> dict[str, Any]:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .dynamics import Dynamics
-from .integrator import Step, StepControl, StepperState
+from .integrator import Integrator, Step, StepperState
 
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 #: Largest step [fraction of Rs/Vs].
@@ -29,12 +29,22 @@ BRANCH_CROSSING = 0.02
 class StepSizes:
     """The step of every active scene, and what the next one will be."""
 
-    __slots__ = ("control", "h", "just_rejected", "landing", "planned", "scale", "unit")
+    __slots__ = (
+        "control",
+        "h",
+        "just_rejected",
+        "known_rates",
+        "landing",
+        "planned",
+        "scale",
+        "unit",
+    )
 
     def __init__(
-        self, control: StepControl | None, h: np.ndarray, scale: np.ndarray, unit: np.ndarray
+        self, integrator: Integrator, h: np.ndarray, scale: np.ndarray, unit: np.ndarray
     ) -> None:
-        self.control = control
+        self.control = integrator.step_control()
+        self.known_rates = integrator.known_rates
         self.h = h
         self.scale = scale  # each component's size (d, n)
         self.unit = unit  # Rs/Vs [s]
@@ -49,7 +59,8 @@ class StepSizes:
         h = np.minimum(self.h, MAX_STEP * self.unit)
         self.planned = self.landing = None
         if self.control.branch_landing:
-            rates = state["derivative"] if "derivative" in state else dynamics.rates(y)
+            known = self.known_rates(state)
+            rates = dynamics.rates(y) if known is None else known
             self.planned = h
             h, self.landing = approach_branches(dynamics, y, h, rates)
         self.h = h

@@ -17,21 +17,12 @@ import numpy as np
 from ..base.errors import IntegrationError
 from ..model.batch import SceneBatch
 from ..model.binding import BoundBatch
-from ..model.impact import (
-    EVENT_OUTCOMES,
-    KINEMATIC_STATE,
-    LATERAL,
-    OBLIQUITY,
-    ONSET,
-    PENETRATION,
-    SPEED,
-    TURNED_BACK,
-    ImpactModel,
-)
+from ..model.events import EVENT_OUTCOMES, EVENTS, ONSET, RESTARTING, TURNED_BACK
+from ..model.impact import KINEMATIC_STATE, LATERAL, OBLIQUITY, PENETRATION, SPEED, ImpactModel
 from ..model.results import BatchResult, Outcome
 from .control import StepSizes
 from .dynamics import Dynamics
-from .events import first_event, sample_step
+from .event_location import first_event, sample_step
 from .integrator import Integrator, StepperState
 from .recorder import ResultRecorder
 
@@ -109,7 +100,8 @@ def _integrate(
     n = batch.size
     width = KINEMATIC_STATE + len(model.failure.state_names)
     scene = np.arange(n)
-    y = np.zeros((width, n))  # failure state integrates zeros until onset sets it
+    y = np.zeros((width, n))
+    y[KINEMATIC_STATE:] = model.new_failure_state(n)
     y[OBLIQUITY], y[SPEED] = batch.core.impact_obliquity, batch.core.impact_speed
     t = np.zeros(n)
     failed, held = np.zeros(n, bool), np.zeros(n, bool)
@@ -117,7 +109,7 @@ def _integrate(
     stats = recorder.stats
     dynamics = Dynamics(model, batch, failed, held, stats)
     sizes = StepSizes(
-        integrator.step_control(),
+        integrator,
         integrator.initial_step(dynamics),
         dynamics.component_scale(width),
         dynamics.time_scale,
@@ -127,7 +119,7 @@ def _integrate(
     recorder.sample(scene, t, y, failed)
     # The event margins at each scene's current state, where known: a step's end is the
     # next step's start unless an event changed the scene.
-    margins_now, known = np.empty((5, n)), np.zeros(n, bool)
+    margins_now, known = np.empty((len(EVENTS), n)), np.zeros(n, bool)
 
     for _ in range(integrator.max_steps):
         if clock is not None and limit is not None and clock.charge(scene.size) > limit:
@@ -208,7 +200,7 @@ def _integrate(
             held[turned] = True
             y[OBLIQUITY, turned] = ImpactModel.MAX_OBLIQUITY
         dynamics = Dynamics(model, batch, failed, held, stats)
-        restart = events[(kinds == ONSET) | (kinds == TURNED_BACK)]
+        restart = events[np.isin(kinds, RESTARTING)]
         if restart.size:  # a new right-hand side from here: the stepper starts afresh
             state = integrator.restart(dynamics, t, y, state, restart)
 

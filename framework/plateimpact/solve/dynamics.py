@@ -64,10 +64,15 @@ class Dynamics:
         return self.model.rates(y, self.failed, self.held, self.batch)
 
     def event_margins(self, y: np.ndarray, kinds: frozenset[int] | None = None) -> np.ndarray:
-        """The event margins (:meth:`ImpactModel.event_margins`), shape (5, n); only the
-        rows ``kinds`` if given."""
+        """The event margins (:meth:`ImpactModel.event_margins`), shape (events, n); only
+        the rows ``kinds`` if given."""
         return self.model.event_margins(y, self.failed, self.held, self.batch, kinds)
 
     def branch_margins(self, y: np.ndarray) -> np.ndarray:
         """The branch surfaces of the force (:meth:`ImpactModel.branch_margins`)."""
         return self.model.branch_margins(y, self.failed, self.batch)
+
+    def at_rest(self, y: np.ndarray) -> np.ndarray:
+        """Which scenes are at rest at ``y`` (the embedment rule,
+        :meth:`ImpactModel.rest_margin`)."""
+        return self.model.rest_margin(y[SPEED], self.batch) >= 0.0

@@ -19,9 +19,10 @@ from ..model.plugin import Plugin
 from .dense import DenseOutput
 from .dynamics import Dynamics
 
-#: Per-scene arrays a stepper carries from one accepted step to the next (last axis:
-#: scenes). ``derivative`` (d, n), if present, is f(y) at the current state, which the
-#: driver then uses instead of evaluating it again (branch prediction).
+#: Per-scene arrays a stepper carries from one accepted step to the next, by names of the
+#: stepper's own choosing (last axis: scenes). The driver selects, subsets and restarts
+#: them but never reads a key: what it may use of them, a stepper says through methods
+#: (:meth:`Integrator.known_rates`).
 StepperState = dict[str, np.ndarray]
 
 #: The work bound of every built-in integrator, counted (never timed), so that where a
@@ -134,6 +135,12 @@ class Integrator(Plugin, ABC):
         self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray, h: np.ndarray, state: StepperState
     ) -> Step:
         """One step of length ``h`` [s] of every scene from (t, y)."""
+
+    def known_rates(self, state: StepperState) -> np.ndarray | None:
+        """dy/dt at the current state, shape (d, n), if the carried ``state`` holds it (a
+        first-same-as-last pair's last stage), so that the driver need not evaluate it
+        again (the branch prediction of adaptive steps); None (default): not known."""
+        return None
 
     def restart(
         self,

@@ -27,7 +27,6 @@ from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.batch import CORE_COLUMNS, SceneBatch
 from ..model.results import BatchResult
-from ..registry.plugin_registry import default_registry
 from ..run.variant import Variant
 from .confined import directory, fsync_fd, shown_version, write_file
 from .contained import check_contained, data_file, index_link_allowed
@@ -261,8 +260,7 @@ def study_group(
 
 
 def _scene_column(name: str, constants: dict[str, Parameter]) -> Parameter:
-    """The declaration of a scene column: a core column or a plate constant, as the run's
-    plug-ins (else any registered plug-in) declare it."""
+    """The declaration of a scene column: a core column or a plate constant, as
+    ``constants`` (the run's plug-ins', then its registry's: the caller's) declare it."""
     declared = CORE_COLUMNS.get(name) or constants.get(name)
-    declared = declared or default_registry().plate_constants.get(name)
     return declared or Parameter(name, f"plate constant {name} (no installed plug-in declares it)")

@@ -18,7 +18,7 @@ from ..base.errors import ParameterError
 from ..base.parameters import Parameter
 from ..model.batch import CORE_COLUMNS
 from ..model.results import RESULT_FIELDS, BatchResult, Outcome
-from ..registry.plugin_registry import default_registry
+from ..registry.plugin_registry import PluginRegistry
 from .append import StudyDefinition
 from .archive import Archive
 from .data_files import encoded
@@ -31,10 +31,10 @@ if TYPE_CHECKING:
 CUBE_DIMENSIONS = ("variant", "plate", "impact_obliquity", "impact_speed")
 
 
-def declared_column(name: str) -> Parameter:
-    """What a scene column is: a core column, else a plate constant a registered
-    plug-in declares, else an undeclared number."""
-    found = CORE_COLUMNS.get(name) or default_registry().plate_constants.get(name)
+def declared_column(name: str, registry: PluginRegistry) -> Parameter:
+    """What a scene column is: a core column, else a plate constant a plug-in of
+    ``registry`` declares, else an undeclared number."""
+    found = CORE_COLUMNS.get(name) or registry.plate_constants.get(name)
     return found or Parameter(name, f"plate constant {name} (no installed plug-in declares it)")
 
 
@@ -48,7 +48,9 @@ def _attributes(declared: Parameter) -> dict[str, Any]:
     return attributes
 
 
-def study_cube(study: StudyDefinition, runs: Mapping[str, BatchResult]) -> xarray.Dataset:
+def study_cube(
+    study: StudyDefinition, runs: Mapping[str, BatchResult], *, registry: PluginRegistry
+) -> xarray.Dataset:
     """A grid study's ``runs`` (by name) as one Dataset over (variant, plate,
     impact_obliquity, impact_speed) [SI, CF attributes]; ParameterError if the scenes
     are not one full grid of plate × obliquity × speed with one sphere."""
@@ -91,7 +93,7 @@ def study_cube(study: StudyDefinition, runs: Mapping[str, BatchResult]) -> xarra
             raise ParameterError(
                 "study", f"study {study.name!r}: {name} varies within a plate; not one cube"
             )
-        coordinates[name] = ("plate", per_plate, _attributes(declared_column(name)))
+        coordinates[name] = ("plate", per_plate, _attributes(declared_column(name, registry)))
     variables: dict[str, Any] = {}
     for name, declared in RESULT_FIELDS.items():
         stack = []
@@ -109,42 +111,46 @@ def study_cube(study: StudyDefinition, runs: Mapping[str, BatchResult]) -> xarra
     )
 
 
-def write_run_netcdf(archive: Archive, run: str, path: Path | BinaryIO) -> None:
+def write_run_netcdf(
+    archive: Archive, run: str, path: Path | BinaryIO, *, registry: PluginRegistry
+) -> None:
     """Write ``run`` of ``archive`` as one netCDF-4 file at ``path`` (a path or a file
     object; as the archive's own data file of a run is: scenes as coordinates, CF
     attributes), whatever the archive's format version."""
     run = archive.resolve(run)
     study = archive.study(run.split("/", 1)[0])
     attributes = {k: v for k, v in archive.raw_attributes(run).items()}
-    declared = {name: declared_column(name) for name in study.scenes.columns}
+    declared = {name: declared_column(name, registry) for name in study.scenes.columns}
     write_run_file(
         path, study.scenes.columns, declared, study.plate_labels, archive.results(run),
         {"study": study.name, "run": run.split("/", 1)[1], **attributes},
     )  # fmt: skip
 
 
-def netcdf_bytes(archive: Archive, run: str) -> bytes:
+def netcdf_bytes(archive: Archive, run: str, *, registry: PluginRegistry) -> bytes:
     """The netCDF-4 file of :func:`write_run_netcdf`, made in memory (libhdf5 writes to
     no disk: no temporary directory that could be full), as bytes for an atomic
     writer."""
-    return encoded(lambda handle: write_run_netcdf(archive, run, handle))
+    return encoded(lambda handle: write_run_netcdf(archive, run, handle, registry=registry))
 
 
-def table_header(archive: Archive, run: str) -> list[str]:
+def table_header(archive: Archive, run: str, *, registry: PluginRegistry) -> list[str]:
     """The tidy table's columns: plate, every scene column and result, units in the
     names (user units: mm, g, m/s, deg)."""
     study = archive.study(archive.resolve(run).split("/", 1)[0])
-    scene = [declared_column(name).key for name in study.scenes.columns]
+    scene = [declared_column(name, registry).key for name in study.scenes.columns]
     return ["plate", *scene, *(field.key for field in RESULT_FIELDS.values())]
 
 
-def table_rows(archive: Archive, run: str) -> Iterator[Sequence[object]]:
+def table_rows(
+    archive: Archive, run: str, *, registry: PluginRegistry
+) -> Iterator[Sequence[object]]:
     """One row per scene, in the units of :func:`table_header` (outcome by name)."""
     run = archive.resolve(run)
     study = archive.study(run.split("/", 1)[0])
     result = archive.results(run)
     scene = [
-        np.asarray(values) / declared_column(name).scale
+        np.asarray(values) / declared_column(name, registry).scale
         for name, values in study.scenes.columns.items()
     ]
     fields: list[Sequence[object]] = []

@@ -19,7 +19,7 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from ..base.errors import ParameterError, PlateFileError
+from ..base.errors import ParameterError, PlateFileError, PluginError
 from ..base.parameters import Parameter
 from ..base.untrusted import described, load_json_file, printable
 from ..model.bodies import THICKNESS, Plate
@@ -31,18 +31,19 @@ FORMAT = "plateimpact-plate-1"
 RESERVED = ("format", "material", "units", "calibration", "notes")
 
 
-def _declarations(registry: PluginRegistry | None) -> dict[str, Parameter]:
-    """Thickness and every registered plate constant, by file key."""
-    declared = [THICKNESS, *(registry or default_registry()).plate_constants.values()]
+def _declarations(registry: PluginRegistry) -> dict[str, Parameter]:
+    """Thickness and every plate constant ``registry`` declares, by file key."""
+    if not isinstance(registry, PluginRegistry):
+        raise PluginError(f"registry must be a PluginRegistry, got {registry!r:.80}")
+    declared = [THICKNESS, *registry.plate_constants.values()]
     return {p.key: p for p in declared}
 
 
 def plate_to_dict(
-    plate: Plate,
-    extra: Mapping[str, Any] | None = None,
-    registry: PluginRegistry | None = None,
+    plate: Plate, extra: Mapping[str, Any] | None = None, *, registry: PluginRegistry
 ) -> dict[str, Any]:
-    """The plate-file object of ``plate``; ``extra`` adds keys (e.g. ``calibration``)."""
+    """The plate-file object of ``plate``, its constants' keys and units as ``registry``
+    declares them; ``extra`` adds keys (e.g. ``calibration``)."""
     by_name = {p.name: p for p in _declarations(registry).values()}
     out: dict[str, Any] = {"format": FORMAT, "material": plate.material}
     units: dict[str, str] = {}
@@ -59,9 +60,7 @@ def plate_to_dict(
     return out
 
 
-def plate_from_dict(
-    data: object, source: str = "plate file", registry: PluginRegistry | None = None
-) -> Plate:
+def plate_from_dict(data: object, source: str = "plate file", *, registry: PluginRegistry) -> Plate:
     """A :class:`Plate` from a plate-file object; :class:`PlateFileError` names ``source``
     and the key."""
     if not isinstance(data, dict):
@@ -109,22 +108,30 @@ def plate_from_dict(
 
 
 def load_plate_file(path: str | os.PathLike[str], registry: PluginRegistry | None = None) -> Plate:
-    """The plate in a plate file (JSON; see the module's description)."""
+    """The plate in a plate file (JSON; see the module's description), its keys read as
+    ``registry`` declares them (an entry point of the API: without one, the installed
+    plug-ins, docs/plugins.md "Where the registry comes from")."""
+    registry = default_registry() if registry is None else registry
     # bounded (nesting, integer digits, size), a duplicate key refused (never the last
     # silently winning); a BOM is allowed
     data = load_json_file(path, PlateFileError)
-    return plate_from_dict(data, printable(os.fspath(path), 200), registry)
+    return plate_from_dict(data, printable(os.fspath(path), 200), registry=registry)
 
 
 def plate_file_text(
-    plate: Plate, extra: Mapping[str, Any] | None = None, registry: PluginRegistry | None = None
+    plate: Plate, extra: Mapping[str, Any] | None = None, *, registry: PluginRegistry
 ) -> str:
     """The plate file of ``plate`` as text (pretty JSON; P* = inf is written ``Infinity``)."""
-    return json.dumps(plate_to_dict(plate, extra, registry), indent=2) + "\n"
+    return json.dumps(plate_to_dict(plate, extra, registry=registry), indent=2) + "\n"
 
 
 def save_plate_file(
-    path: str | os.PathLike[str], plate: Plate, extra: Mapping[str, Any] | None = None
+    path: str | os.PathLike[str],
+    plate: Plate,
+    extra: Mapping[str, Any] | None = None,
+    registry: PluginRegistry | None = None,
 ) -> None:
-    """Write ``plate`` to ``path`` as a plate file, atomically (storage.output)."""
-    write_text(path, plate_file_text(plate, extra), "plate file", kind="json")
+    """Write ``plate`` to ``path`` as a plate file, atomically (storage.output); an entry
+    point of the API: without ``registry``, the installed plug-ins declare its keys."""
+    registry = default_registry() if registry is None else registry
+    write_text(path, plate_file_text(plate, extra, registry=registry), "plate file", kind="json")

@@ -26,7 +26,7 @@ import h5py
 
 from ..base.errors import ArchiveError
 from ..base.untrusted import printable
-from ..registry.plugin_registry import default_registry
+from ..registry.plugin_registry import PluginRegistry
 from . import stored_attributes as typed
 from .append import FORMAT, FORMAT_VERSION, add_run
 from .archive import WAIT, Archive
@@ -48,9 +48,10 @@ def backup_path(path: Path) -> Path:
     return path.with_name(f"{path.name}.format1{path.suffix or '.h5'}")
 
 
-def upgrade(path: str | os.PathLike[str], *, wait: float = WAIT) -> Path:
-    """Rewrite the format-1 archive at ``path`` as format 2; returns where the format-1
-    file was kept. ArchiveError (one line) if it is not a format-1 archive, if the place
+def upgrade(path: str | os.PathLike[str], *, registry: PluginRegistry, wait: float = WAIT) -> Path:
+    """Rewrite the format-1 archive at ``path`` as format 2 (the plate constants' units
+    and descriptions as ``registry`` declares them); returns where the format-1 file was
+    kept. ArchiveError (one line) if it is not a format-1 archive, if the place
     for the old file is taken by another file, or if another writer keeps the archive
     longer than ``wait`` [s]. Rerun after a failure or a crash, it completes."""
     old = Archive(path, wait=wait)
@@ -67,7 +68,7 @@ def upgrade(path: str | os.PathLike[str], *, wait: float = WAIT) -> Path:
                 raise ArchiveError(f"{label} has format version {version}: nothing to upgrade")
             with directory(old.real.parent, f"{label}: directory", follow=True) as parent:
                 _check_kept(parent, old.real, kept, label)
-                _rewrite(old, parent, kept, replaced)
+                _rewrite(old, parent, kept, replaced, registry)
     except ArchiveError:
         raise
     except OSError as exc:  # a full disk, a lost mount
@@ -96,7 +97,9 @@ def _read(parent: int, path: Path, label: str) -> bytes:
         return handle.read()
 
 
-def _rewrite(old: Archive, parent: int, kept: Path, replaced: list[bool]) -> None:
+def _rewrite(
+    old: Archive, parent: int, kept: Path, replaced: list[bool], registry: PluginRegistry
+) -> None:
     """Write the new archive's data files and index, keep the format-1 file, replace the
     path by the new index (``replaced`` gets True once it has)."""
     files = DataFiles(old.real, parent)
@@ -110,7 +113,7 @@ def _rewrite(old: Archive, parent: int, kept: Path, replaced: list[bool]) -> Non
                 f"plateimpact study archive (index; the runs' data in {files.directory.name}/"
                 "); see docs/archive.md"
             )
-            _copy_runs(old, f, files)
+            _copy_runs(old, f, files, registry)
             _copy_records(old, f, files)
         fault_point("built")
         files.sync()
@@ -128,8 +131,8 @@ def _rewrite(old: Archive, parent: int, kept: Path, replaced: list[bool]) -> Non
         files.close()
 
 
-def _copy_runs(old: Archive, f: h5py.File, files: DataFiles) -> None:
-    constants = dict(default_registry().plate_constants)
+def _copy_runs(old: Archive, f: h5py.File, files: DataFiles, registry: PluginRegistry) -> None:
+    constants = dict(registry.plate_constants)
     for run in old.runs():
         study_name, name = run.split("/", 1)
         study = old.study(study_name)

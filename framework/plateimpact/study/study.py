@@ -275,8 +275,10 @@ class Study:
                 if writer is not None:
                     try:
                         plan = planned[variant.name]
+                        # the run's plug-ins' declarations, else its registry's
+                        declared = {**simulation.registry.plate_constants, **constants}
                         writer.append_run(
-                            self, variant, result, metadata.as_attributes(), constants,
+                            self, variant, result, metadata.as_attributes(), declared,
                             run=plan.run, overwrite=plan.replace or plan.kept is not None,
                         )  # fmt: skip
                     except ArchiveBusyError as exc:  # the run was saved aside: say where
@@ -303,13 +305,17 @@ class StudyResults:
         }
         return cls(definition, runs)
 
-    def to_xarray(self) -> xarray.Dataset:
+    def to_xarray(self, registry: PluginRegistry | None = None) -> xarray.Dataset:
         """A grid study's runs as one xarray Dataset over (variant, plate,
-        impact_obliquity, impact_speed), SI with CF ``units``; ParameterError if the
-        scenes are not one full grid (plateimpact.storage.export.study_cube)."""
+        impact_obliquity, impact_speed), SI with CF ``units`` (plate constants' as
+        ``registry`` declares them; an entry point of the API: without one, the installed
+        plug-ins); ParameterError if the scenes are not one full grid
+        (plateimpact.storage.export.study_cube)."""
         from ..storage.export import study_cube  # noqa: PLC0415 (xarray only when asked for)
 
-        return study_cube(self.study, self.runs)
+        registry = default_registry() if registry is None else registry
+
+        return study_cube(self.study, self.runs, registry=registry)
 
     def __getitem__(self, name: str) -> BatchResult:
         try:

@@ -1,4 +1,5 @@
-"""A third-party plug-in package: two resistance laws that are not the report's.
+"""A third-party plug-in package: two resistance laws that are not the report's, a
+failure model and an integrator.
 
 * ``isotropic-poncelet``: σ = a + b V² [N/m²], the classical form the report starts
   from ("F = A(a + bV²)"), whatever the angle between the path and the force. It equals
@@ -7,9 +8,13 @@
   σ = a (1 + c ln(1 + V cos ψ / V_ref)) + b V² cos² ψ. It brings its own plate constant,
   the rate sensitivity ``c`` [1], and a setting, the reference speed ``V_ref`` [m/s]; with
   c = 0 it is eq 1 exactly.
+* ``brittle`` (:mod:`.brittle`): a brittle plate that breaks up at P* and keeps a
+  fraction of its resistance until the sphere has passed its back face.
+* ``rk4`` (:mod:`.rk4`): classical fourth-order Runge–Kutta at a fixed step.
 
-Nothing in plateimpact's core knows either: they are declared here and registered
-through the ``plateimpact`` entry-point group.
+Nothing in plateimpact's core knows any of them: they are written against the public
+contract (docs/plugins.md, where each is shown), declared here and registered through the
+``plateimpact`` entry-point group.
 """
 
 from __future__ import annotations
@@ -21,6 +26,9 @@ import numpy as np
 
 from plateimpact import Parameter, PluginRegistry, Range, ResistanceLaw, SceneBatch, hookimpl
 from plateimpact_plugins.report import DENSITY_B, STRENGTH_A
+
+from .brittle import Brittle
+from .rk4 import ClassicalRungeKutta
 
 RATE_SENSITIVITY = Parameter(
     "rate_sensitivity",
@@ -49,11 +57,11 @@ class RatePoncelet(ResistanceLaw):
 
     reference_speed: float = REFERENCE_SPEED.field()
 
-    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
         normal_speed = speed * np.cos(incidence)
         rate = np.log1p(np.maximum(normal_speed, 0.0) / self.reference_speed)
-        strength = batch.a * (1.0 + batch.rate_sensitivity * rate)
-        return strength + batch.b * normal_speed * normal_speed
+        strength = scenes.a * (1.0 + scenes.rate_sensitivity * rate)
+        return strength + scenes.b * normal_speed * normal_speed
 
 
 @final
@@ -64,11 +72,11 @@ class IsotropicPoncelet(ResistanceLaw):
     name = "isotropic-poncelet"
     plate_constants = (STRENGTH_A, DENSITY_B)
 
-    def stress(self, speed: np.ndarray, incidence: np.ndarray, batch: SceneBatch) -> np.ndarray:
-        return batch.a + batch.b * speed * speed
+    def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
+        return scenes.a + scenes.b * speed * speed
 
 
 @hookimpl
 def plateimpact_register(registry: PluginRegistry) -> None:
-    registry.add(IsotropicPoncelet)
-    registry.add(RatePoncelet)
+    for cls in (IsotropicPoncelet, RatePoncelet, Brittle, ClassicalRungeKutta):
+        registry.add(cls)

@@ -5,24 +5,25 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
-from .. import limits as lim
-from ..base.errors import V50Error
-from ..model.bodies import Sphere
-from ..registry.plugin_registry import PluginRegistry
-from ..run.progress import reporting_scenes
-from ..storage.shots import Shots
-from ..v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
-from ..v50.fit import DEFAULT_BOOTSTRAP
-from ..v50.likelihood import shown as count_shown
-from .common import UsageError, add_dpi_option, check_directory, save_figure_atomically, say
-from .describe import shown
-from .options import add_body_options, add_model_options, bodies, model_choice, typed
+from ... import limits as lim
+from ...base.errors import V50Error
+from ...model.bodies import Sphere
+from ...model.scene import IMPACT_OBLIQUITY
+from ...registry.plugin_registry import PluginRegistry
+from ...run.progress import reporting_scenes
+from ...storage.shots import Shots
+from ...v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50, mil_std_662f
+from ...v50.fit import DEFAULT_BOOTSTRAP
+from ...v50.likelihood import shown as count_shown
+from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
+from ..formatting import number, shown, user
+from ..options import add_body_options, add_model_options, bodies, model_choice, typed
+from ..writer import Writer
 
 MIL_STD = "mil-std-662f"
 #: Options of the fits, and of MIL-STD-662F: each refused with the other method.
@@ -37,18 +38,14 @@ MAX_FITS = 1_000_000
 Estimate = V50Fit | MilStd662F
 
 
-def add_parsers(sub: Any, registry: PluginRegistry) -> None:
-    """Add the ``v50`` sub-command to the sub-parsers ``sub``."""
-    p = sub.add_parser(
-        "v50",
-        help="V50 of go/no-go shots: probit or logit fit with confidence intervals, or "
-        "the MIL-STD-662F estimate",
-        description="Estimate the V50 ballistic limit of go/no-go shots: a maximum-likelihood "
+def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
+    p.description = (
+        "Estimate the V50 ballistic limit of go/no-go shots: a maximum-likelihood "
         "probit or logit fit of P(perforation) against impact speed, with V50, sigma, V10 and "
         "V90 and their profile-likelihood and bootstrap confidence intervals, or the "
         "MIL-STD-662F mean of the highest partial and lowest complete penetrations within a "
         "velocity span. With a plate (--preset, --plate-file or plate options) the model's "
-        "ballistic limit at each obliquity is reported and drawn beside it.",
+        "ballistic limit at each obliquity is reported and drawn beside it."
     )
     p.add_argument(
         "shots",
@@ -108,7 +105,7 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     add_model_options(probe, registry)
     model_options = sorted(vars(probe.parse_args([])))
     add_dpi_option(p)
-    p.set_defaults(command_function=v50_command, model_options=model_options)
+    p.set_defaults(model_options=model_options)
 
 
 def _number(text: str, flag: str, kind: type = float) -> Any:
@@ -150,7 +147,7 @@ def _estimator(args: argparse.Namespace) -> Callable[..., Estimate]:
 def _groups(args: argparse.Namespace, shots: Shots) -> dict[float, Shots]:
     groups = shots.groups_by_obliquity()
     if len(groups) > 1 and not args.by_obliquity:
-        angles = ", ".join(f"{math.degrees(o):g}" for o in groups)
+        angles = ", ".join(number(IMPACT_OBLIQUITY, o) for o in groups)
         raise UsageError(
             f"{args.shots}: shots at {len(groups)} obliquities ({angles} deg): a V50 is of "
             "one obliquity; give --by-obliquity for one V50 each"
@@ -177,13 +174,13 @@ def _check_fits(args: argparse.Namespace, groups: int) -> None:
 
 
 def _model_limits(
-    args: argparse.Namespace, groups: dict[float, Shots]
+    args: argparse.Namespace, groups: dict[float, Shots], registry: PluginRegistry
 ) -> tuple[dict[float, float | None], str | None]:
     """The model's ballistic limit [m/s] at each group's obliquity, when a plate or model
     option was given (None where the model has none in the speeds searched)."""
     if not any(getattr(args, name) not in (None, []) for name in args.model_options):
         return {}, None
-    choice = model_choice(args)
+    choice = model_choice(args, registry)
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)
     by_sphere: dict[Sphere, list[float]] = {}
@@ -191,7 +188,7 @@ def _model_limits(
         radius, mass = group.spheres(sphere)
         if np.ptp(radius) > 0 or np.ptp(mass) > 0:
             raise UsageError(
-                f"{args.shots} at {math.degrees(obliquity):g} deg: the shots give "
+                f"{args.shots} at {number(IMPACT_OBLIQUITY, obliquity)} deg: the shots give "
                 "different spheres (radius_mm, mass_g); the model's ballistic limit is of "
                 "one sphere: give shots of one sphere per obliquity"
             )
@@ -213,17 +210,17 @@ def _model_limits(
     return found, f"{label}, {simulation.model.resistance.name} + {failure}"
 
 
-def v50_command(args: argparse.Namespace) -> None:
+def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     """Run ``plateimpact v50``."""
     check_directory(args.png, "--png", "figure")
     estimate = _estimator(args)
     shots = Shots.from_csv(args.shots)
     groups = _groups(args, shots)
     _check_fits(args, len(groups))
-    model_limits, model = _model_limits(args, groups)
+    model_limits, model = _model_limits(args, groups, registry)
     results: dict[float, Estimate | str] = {}
     for obliquity, group in groups.items():
-        label = f"{args.shots} at {math.degrees(obliquity):g} deg"
+        label = f"{args.shots} at {number(IMPACT_OBLIQUITY, obliquity)} deg"
         try:
             results[obliquity] = estimate(group.impact_speed, group.perforated, group.weight, label)
         except V50Error as exc:
@@ -231,26 +228,27 @@ def v50_command(args: argparse.Namespace) -> None:
                 raise
             results[obliquity] = str(exc).removeprefix(f"{label}: ")
     if all(isinstance(r, str) for r in results.values()):
-        reasons = "; ".join(f"{math.degrees(o):g} deg: {r}" for o, r in results.items())
+        reasons = "; ".join(f"{number(IMPACT_OBLIQUITY, o)} deg: {r}" for o, r in results.items())
         raise V50Error(f"{args.shots}: no obliquity gives a V50; {reasons}")
     if args.png is not None:
-        from ..figures.v50_fits import Panel, v50_figure  # noqa: PLC0415 (matplotlib only when drawing)
+        from ...figures.v50_fits import Panel, v50_figure  # noqa: PLC0415 (matplotlib only when drawing)
 
         panels = [
-            Panel(f"{math.degrees(o):g} deg", groups[o].impact_speed, groups[o].perforated,
-                  groups[o].weight, r, model_limits.get(o))
+            Panel(f"{number(IMPACT_OBLIQUITY, o)} deg", groups[o].impact_speed,
+                  groups[o].perforated, groups[o].weight, r, model_limits.get(o))
             for o, r in results.items()
         ]  # fmt: skip
         figure = v50_figure(panels, title=args.shots, model=model)
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     rows = [_json(args, o, r, groups[o].labels, model_limits, model) for o, r in results.items()]
     if args.json:
-        say(json.dumps(rows[0] if len(rows) == 1 else rows))
+        out.say(json.dumps(rows[0] if len(rows) == 1 else rows))
     else:
         for row in rows:
-            say(_text(row))
+            out.say(_text(row))
         if args.png is not None:
-            say(f"figure: {args.png}")
+            out.say(f"figure: {args.png}")
+    return 0
 
 
 def _json(
@@ -258,7 +256,7 @@ def _json(
     model_limits: dict[float, float | None], model: str | None,
 ) -> dict[str, Any]:  # fmt: skip
     # 30, not 29.999999999999996 after the round trip through rad
-    degrees = float(f"{math.degrees(obliquity):.12g}")
+    degrees = float(f"{user(IMPACT_OBLIQUITY, obliquity):.12g}")
     row: dict[str, Any] = {"shots_file": args.shots, "obliquity_deg": degrees}
     if isinstance(result, str):
         row.update({"method": args.method, "error": result})

@@ -4,36 +4,32 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
-from typing import Any
 
 import numpy as np
 
-from ..experiment import MEASURED, PREDICTED, ValidationReport, validate
-from ..experiment.validation import MAX_VALIDATE_SCENES
-from ..registry.plugin_registry import PluginRegistry
-from ..run.progress import reporting_scenes
-from ..storage.shots import Shots
-from .common import add_dpi_option, check_directory, save_figure_atomically, say
-from .describe import shown
-from .options import add_body_options, add_model_options, bodies, model_choice
+from ...experiment import MEASURED, PREDICTED, ValidationReport, validate
+from ...experiment.validation import MAX_VALIDATE_SCENES
+from ...model.scene import IMPACT_OBLIQUITY
+from ...registry.plugin_registry import PluginRegistry
+from ...run.progress import reporting_scenes
+from ...storage.shots import Shots
+from ..common import add_dpi_option, check_directory, save_figure_atomically
+from ..formatting import ANGLE, number, quantity, shown
+from ..options import add_body_options, add_model_options, bodies, model_choice
+from ..writer import Writer
 
 #: Disagreeing shots listed in the text output (--json lists all).
 LISTED = 10
 
 
-def add_parsers(sub: Any, registry: PluginRegistry) -> None:
-    """Add the ``validate`` sub-command to the sub-parsers ``sub``."""
-    p = sub.add_parser(
-        "validate",
-        help="run the model on measured shots: outcome agreement, residual-speed and "
-        "exit-obliquity errors, the shots that disagree",
-        description="Run the model on every shot of SHOTS.csv and compare: the confusion "
+def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
+    p.description = (
+        "Run the model on every shot of SHOTS.csv and compare: the confusion "
         "matrix of outcomes (measured -> predicted; go/no-go shots perforated or not), the "
         "weighted agreement, the residual-speed error (RMS and bias, model minus measured) "
         "and exit-obliquity error (RMS) where shot and model both leave the plate the same "
         "way, and each disagreeing shot with its distance along impact speed to the nearest "
-        "boundary of the model beyond which it gives what was measured.",
+        "boundary of the model beyond which it gives what was measured."
     )
     p.add_argument(
         "shots",
@@ -57,71 +53,73 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     add_body_options(p, registry)
     add_model_options(p, registry)
     add_dpi_option(p)
-    p.set_defaults(command_function=validate_command)
 
 
-def validate_command(args: argparse.Namespace) -> None:
+def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     """Run ``plateimpact validate``."""
     check_directory(args.png, "--png", "figure")
     shots = Shots.from_csv(args.shots)
     if args.png is not None:
-        from ..figures.validation_panels import check_panels  # noqa: PLC0415 (matplotlib)
+        from ...figures.validation_panels import check_panels  # noqa: PLC0415 (matplotlib)
 
         check_panels(shots)
-    choice = model_choice(args)
+    choice = model_choice(args, registry)
     simulation = choice.simulation()
     sphere, plate, label = bodies(args, choice, simulation.model)
     with reporting_scenes("validate"):  # a count of scenes on a terminal after 2 s
         bound = None if args.force else MAX_VALIDATE_SCENES
         report = validate(simulation, sphere, plate, shots, max_scenes=bound)
         if args.png is not None:
-            from ..figures.validation_panels import validation_figure  # noqa: PLC0415 (matplotlib)
+            from ...figures.validation_panels import validation_figure  # noqa: PLC0415 (matplotlib)
 
             figure = validation_figure(report, simulation, title=label)
     if args.png is not None:
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     if args.json:
-        say(json.dumps({"shots_file": args.shots, "plate_label": label, **report.to_json()}))
+        out.say(json.dumps({"shots_file": args.shots, "plate_label": label, **report.to_json()}))
     else:
-        _print_text(args, label, report)
+        _print_text(args, label, report, out)
+    return 0
 
 
-def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) -> None:
+def _print_text(
+    args: argparse.Namespace, label: str, report: ValidationReport, out: Writer
+) -> None:
     shots = report.shots
     model = report.model
     go_no_go = int((shots.outcome == 0).sum())
     obliquities = np.unique(shots.impact_obliquity)  # a file may measure each shot's
-    angles = ", ".join(f"{math.degrees(o):.6g}" for o in obliquities[:LISTED])
+    angles = ", ".join(number(IMPACT_OBLIQUITY, o) for o in obliquities[:LISTED])
     if obliquities.size > LISTED:
         angles += f", ... ({obliquities.size:,} obliquities)"
-    say(
+    out.say(
         f"{shown(label, None)}: {len(shots)} shots from {shown(args.shots, None)}"
         + (f" ({go_no_go} go/no-go)" if go_no_go else "")
         + f" at {angles} deg; model {shown(model['resistance'])} + {shown(model['failure'])} "
         f"({shown(model['integrator'])})"
     )
-    say(f"outcome agreement {100 * report.agreement:.1f}% (weighted)")
+    out.say(f"outcome agreement {100 * report.agreement:.1f}% (weighted)")
     width = max(len(name) for name in MEASURED) + 2
-    say(f"  {'measured -> model':{width}s}" + "".join(f"{p:>13s}" for p in PREDICTED))
+    out.say(f"  {'measured -> model':{width}s}" + "".join(f"{p:>13s}" for p in PREDICTED))
     for name in MEASURED:
         counts = report.confusion[name]
         if any(counts.values()):
-            say(f"  {name:{width}s}" + "".join(f"{counts[p]:13d}" for p in PREDICTED))
+            out.say(f"  {name:{width}s}" + "".join(f"{counts[p]:13d}" for p in PREDICTED))
     pairs = int(np.isfinite(report.residual_speed_error).sum())
     if pairs:
-        say(
+        out.say(
             f"residual speed, model - measured: rms {report.residual_speed_rms:.3g} m/s, "
             f"bias {report.residual_speed_bias:+.3g} m/s over {pairs} shots"
         )
     else:
-        say("residual speed: no shot where shot and model leave the plate the same way")
+        out.say("residual speed: no shot where shot and model leave the plate the same way")
     pairs = int(np.isfinite(report.exit_obliquity_error).sum())
     if pairs:
-        rms = math.degrees(report.exit_obliquity_rms)
-        say(f"exit obliquity, model - measured: rms {rms:.3g} deg over {pairs} shots")
+        rms = quantity(ANGLE, report.exit_obliquity_rms, 3)
+        out.say(f"exit obliquity, model - measured: rms {rms} over {pairs} shots")
     wrong = report.disagreements
     if wrong:
-        say(f"{len(wrong)} shots disagree (distance to the nearest speed the model agrees at):")
+        out.say(f"{len(wrong)} shots disagree (distance to the nearest speed the model agrees at):")
     for d in wrong[:LISTED]:
         where = (
             f"{d.distance:.3g} m/s from the boundary at {d.boundary:.2f} m/s"
@@ -129,12 +127,12 @@ def _print_text(args: argparse.Namespace, label: str, report: ValidationReport) 
             else f"no boundary in {report.speeds[0]:g}-{report.speeds[1]:g} m/s"
         )
         line = d.label.removeprefix(f"{args.shots} ")  # the file is named above
-        angle = math.degrees(d.impact_obliquity)
-        say(
-            f"  {shown(line, None)}: {d.impact_speed:g} m/s at {angle:.6g} deg, measured "
+        angle = quantity(IMPACT_OBLIQUITY, d.impact_obliquity)
+        out.say(
+            f"  {shown(line, None)}: {d.impact_speed:g} m/s at {angle}, measured "
             f"{d.measured}, model {d.predicted}; {where}"
         )
     if len(wrong) > LISTED:
-        say(f"  ... and {len(wrong) - LISTED} more (--json lists all)")
+        out.say(f"  ... and {len(wrong) - LISTED} more (--json lists all)")
     if args.png is not None:
-        say(f"figure: {args.png}")
+        out.say(f"figure: {args.png}")

@@ -1,5 +1,5 @@
 """``plateimpact calibrate``: a and b from shots at normal incidence (eqs 40–49), or with
-``--fit pstar`` P* and α* from oblique shots (:mod:`.calibrate_pstar`)."""
+``--fit pstar`` P* and α* from oblique shots (:mod:`plateimpact.cli.calibrate_pstar`)."""
 
 from __future__ import annotations
 
@@ -11,25 +11,20 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
-from ..base.units import g, mm
-from ..calibration import MAX_FIT_SCENES, model_residual_speeds
-from ..model.bodies import Plate, Sphere
-from ..provenance.metadata import versions
-from ..registry.plugin_registry import PluginRegistry
-from ..run.progress import reporting_scenes
-from ..run.simulation import Simulation
-from ..storage.plate_file import plate_file_text
-from ..storage.shots import Shots
-from ..storage.together import write_together
-from .calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
-from .common import (
-    add_dpi_option,
-    check_directory,
-    figure_output,
-    say,
-    text_output,
-)
-from .options import add_body_options, add_model_options, bodies, model_choice
+from ...base.units import g, mm
+from ...calibration import MAX_FIT_SCENES, model_residual_speeds
+from ...model.bodies import Plate, Sphere
+from ...provenance.metadata import versions
+from ...registry.plugin_registry import PluginRegistry
+from ...run.progress import reporting_scenes
+from ...run.simulation import Simulation
+from ...storage.plate_file import plate_file_text
+from ...storage.shots import Shots
+from ...storage.together import write_together
+from ..calibrate_pstar import add_pstar_options, pstar_command, refuse_pstar_options
+from ..common import add_dpi_option, check_directory, figure_output, text_output
+from ..options import add_body_options, add_model_options, bodies, model_choice
+from ..writer import Writer
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -41,18 +36,14 @@ CalibrationReport: TypeAlias = Any
 CURVE_POINTS = 150
 
 
-def add_parsers(sub: Any, registry: PluginRegistry) -> None:
-    """Add the ``calibrate`` sub-command to the sub-parsers ``sub``."""
-    p = sub.add_parser(
-        "calibrate",
-        help="fit a and b to residual speeds at normal incidence (DRI fit, eqs 40-49), "
-        "or P* and alpha* to oblique shots (--fit pstar)",
-        description="Fit the Poncelet constants a and b to shots at normal incidence: the "
+def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
+    p.description = (
+        "Fit the Poncelet constants a and b to shots at normal incidence: the "
         "DRI fit (eqs 40-41), the report's Newton iteration (eqs 44-49) and a direct "
         "least-squares fit; P* and alpha* are given (from craters, as in the report). "
         "With --fit pstar: a and b given, fit P* (and alpha*) to the outcomes and "
         "residual speeds of oblique shots by maximum likelihood, or with --by-obliquity "
-        "the report's variable P*.",
+        "the report's variable P*."
     )
     p.add_argument(
         "shots",
@@ -92,20 +83,19 @@ def add_parsers(sub: Any, registry: PluginRegistry) -> None:
     add_pstar_options(p)
     add_body_options(p, registry)
     add_model_options(p, registry)
-    p.set_defaults(command_function=calibrate_command)
 
 
-def calibrate_command(args: argparse.Namespace) -> None:
+def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     """Run ``plateimpact calibrate``."""
     if args.fit == "pstar":
-        pstar_command(args)
-        return
+        pstar_command(args, registry, out)
+        return 0
     refuse_pstar_options(args)
     args.method = args.method or "newton"
     check_directory(args.out, "--out")
     check_directory(args.png, "--png", "figure")
     shots = Shots.from_csv(args.shots)
-    choice = model_choice(args)
+    choice = model_choice(args, registry)
     simulation = choice.simulation()
     # a and b are what the calibration finds: placeholders until then.
     choice.plate.setdefault("a", 1.0)
@@ -125,15 +115,17 @@ def calibrate_command(args: argparse.Namespace) -> None:
     if args.out is not None:
         provenance = _provenance(args, report, chosen, sphere)
         extra = {"calibration": {**provenance, "model": summary["model"]}}
-        outputs.append(text_output(args.out, plate_file_text(chosen.plate, extra), "--out"))
+        text = plate_file_text(chosen.plate, extra, registry=registry)
+        outputs.append(text_output(args.out, text, "--out"))
     if args.png is not None:
         figure = _figure(report, sphere, simulation)
         outputs.append(figure_output(figure, args.png, "--png", args.dpi))
     write_together(outputs)
     if args.json:
-        say(json.dumps(summary))
+        out.say(json.dumps(summary))
     else:
-        _print_text(args, report, chosen)
+        _print_text(args, report, chosen, out)
+    return 0
 
 
 def _finite(x: float) -> float | None:
@@ -196,20 +188,22 @@ def _provenance(
     }
 
 
-def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Calibration) -> None:
+def _print_text(
+    args: argparse.Namespace, report: CalibrationReport, chosen: Calibration, out: Writer
+) -> None:
     normal = report.shots.normal_incidence()
     ignored = len(report.shots) - len(normal)
     dri = report.dri
-    say(
+    out.say(
         f"shots: {args.shots}: {len(normal)} at normal incidence, "
         f"{int(normal.perforated.sum())} perforating"
         + (f" ({ignored} oblique shots not used)" if ignored else "")
     )
-    say(
+    out.say(
         f"DRI fit (eqs 40-41): R = {dri.R:.5g} ± {dri.R_stderr:.2g}, "
         f"V0 = {dri.V0:.5g} ± {dri.V0_stderr:.2g} m/s, rms residual {dri.rms_residual:.3g} m/s"
     )
-    say(
+    out.say(
         f"{'':22s}{'a [N/m^2]':>22s}{'b [kg/m^3]':>20s}{'steps':>7s}"
         f"{'model R':>10s}{'model V0':>10s}{'rms [m/s]':>10s}"
     )
@@ -217,29 +211,29 @@ def _print_text(args: argparse.Namespace, report: CalibrationReport, chosen: Cal
         ("newton (eqs 44-49)", report.newton),
         ("direct least squares", report.direct),
     ):
-        say(
+        out.say(
             f"{name:22s}{f'{fit.a:.5g} ± {fit.a_stderr:.2g}':>22s}"
             f"{f'{fit.b:.5g} ± {fit.b_stderr:.2g}':>20s}{fit.iterations:7d}"
             f"{fit.model_fit.R:10.5g}{fit.model_fit.V0:10.5g}{fit.rms_residual:10.3g}"
         )
     newton, direct = report.newton, report.direct
-    say(
+    out.say(
         f"direct - newton: a {100 * (direct.a / newton.a - 1):+.3g} %, "
         f"b {100 * (direct.b / newton.b - 1):+.3g} % "
         f"({abs(direct.a - newton.a) / newton.a_stderr:.2g} and "
         f"{abs(direct.b - newton.b) / newton.b_stderr:.2g} standard errors of newton)"
     )
-    say(f"plate ({chosen.method}): a = {chosen.a:.6g} N/m^2, b = {chosen.b:.6g} kg/m^3")
+    out.say(f"plate ({chosen.method}): a = {chosen.a:.6g} N/m^2, b = {chosen.b:.6g} kg/m^3")
     if args.out is not None:
-        say(f"plate file: {args.out}")
+        out.say(f"plate file: {args.out}")
     if args.png is not None:
-        say(f"figure: {args.png}")
+        out.say(f"figure: {args.png}")
 
 
 def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -> Figure:
     """Residual speed against impact speed: shots, DRI fit, model curves of both fits."""
-    from ..figures.calibration_fit import plot_calibration  # noqa: PLC0415 (matplotlib only when drawing)
-    from ..figures.style import figure  # noqa: PLC0415
+    from ...figures.calibration_fit import plot_calibration  # noqa: PLC0415 (matplotlib only when drawing)
+    from ...figures.style import figure  # noqa: PLC0415
 
     normal = report.shots.normal_incidence()
     speeds = np.linspace(

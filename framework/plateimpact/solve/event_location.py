@@ -7,6 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..model.events import EVENTS
 from ..model.impact import OBLIQUITY
 from .dense import DenseOutput
 from .dynamics import Dynamics
@@ -33,7 +34,7 @@ def sample_step(
     samples[:, 0], samples[:, -1] = y0, y1
     for j in range(1, at.size - 1):
         samples[:, j] = dense(at[j])
-    margins = np.empty((5, at.size, y0.shape[1]))
+    margins = np.empty((len(EVENTS), at.size, y0.shape[1]))
     for j in range(at.size):
         if j == 0 and margins0 is not None:
             margins[:, 0] = margins0
