@@ -10,6 +10,7 @@ import attrs
 import numpy as np
 
 from ..base.errors import ParameterError
+from ..base.parameters import Parameter
 from ..base.untrusted import load_json
 from ..model.impact import REST_SPEED_FRACTION
 from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
@@ -52,11 +53,10 @@ def _settings(value: Mapping[str, Any] | None) -> dict[str, Any]:
     return _as_json(value or {}) or dict(value or {})
 
 
-def _declared_json(kind: str, plugin: str, settings: dict[str, Any]) -> dict[str, Any]:
+def _declared_json(declared: Mapping[str, Parameter], settings: dict[str, Any]) -> dict[str, Any]:
     """Settings whose values are not all JSON, converted by the plug-in's declarations
-    (``Parameter.to_json``: a table setting gives its rows), so that a variant holds what
-    the archive stores; the plug-in is looked up in the installed packages."""
-    declared = default_registry().get(kind, plugin).setting_declarations()
+    ``declared`` (``Parameter.to_json``: a table setting gives its rows), so that a variant
+    holds what the archive stores."""
     converted = {
         name: declared[name].json_value(value) if name in declared else value
         for name, value in settings.items()
@@ -66,11 +66,6 @@ def _declared_json(kind: str, plugin: str, settings: dict[str, Any]) -> dict[str
         bad = next(v for v in converted.values() if _as_json({"v": v}) is None)
         raise ParameterError("settings", f"setting value {bad!r:.80} is not a JSON value")
     return found
-
-
-def _default(kind: str) -> Any:
-    """The registry's default plug-in of ``kind``, when a variant names none."""
-    return attrs.Factory(lambda: default_registry().default(kind))
 
 
 def check_name(instance: object, attribute: attrs.Attribute, value: object) -> None:
@@ -100,13 +95,20 @@ class Variant:
     Settings are held as JSON values, exactly as the archive stores them, so a variant
     read back from an archive equals this one: a value with no JSON form of its own (a
     plug-in's table) is converted by the setting's declaration (``Parameter.to_json``).
-    A plug-in not named is the installed packages' default of its kind.
+    A plug-in not named is the installed packages' default of its kind (the registry's
+    ``default``); the plug-ins are looked up there, too, to convert such a value.
     """
 
     name: str = attrs.field(validator=check_name)
-    resistance: str = attrs.field(default=_default("resistance"), validator=check_plugin_name)
-    failure: str = attrs.field(default=_default("failure"), validator=check_plugin_name)
-    integrator: str = attrs.field(default=_default("integrator"), validator=check_plugin_name)
+    resistance: str = attrs.field(
+        factory=lambda: default_registry().default("resistance"), validator=check_plugin_name
+    )
+    failure: str = attrs.field(
+        factory=lambda: default_registry().default("failure"), validator=check_plugin_name
+    )
+    integrator: str = attrs.field(
+        factory=lambda: default_registry().default("integrator"), validator=check_plugin_name
+    )
     resistance_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     failure_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     integrator_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
@@ -115,9 +117,10 @@ class Variant:
     def __attrs_post_init__(self) -> None:
         for kind in KINDS:
             settings = getattr(self, f"{kind}_settings")
-            if _as_json(settings) is None:
-                plugin = getattr(self, kind)
-                object.__setattr__(self, f"{kind}_settings", _declared_json(kind, plugin, settings))
+            if _as_json(settings) is None:  # the installed plug-in's declarations convert it
+                cls = default_registry().get(kind, getattr(self, kind))
+                converted = _declared_json(cls.setting_declarations(), settings)
+                object.__setattr__(self, f"{kind}_settings", converted)
 
     def simulation(self, registry: PluginRegistry | None = None) -> Simulation:
         """The resolved model and integrator (plug-ins looked up by name once)."""
