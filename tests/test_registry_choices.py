@@ -121,3 +121,13 @@ def test_the_moved_calibration_names_still_work_deprecated_through_the_registry(
     assert BUILTINS.procedure("calibration") is fits
     with pytest.raises(pi.UnknownNameError, match="no installed plug-in package provides"):
         pi.load_registry(entry_points=False).procedure("calibration")
+
+
+def test_a_registry_that_ran_a_procedure_still_goes_to_a_worker_process():
+    import pickle  # noqa: PLC0415
+
+    registry = pi.load_registry()
+    registry.procedure("calibration")  # loaded: a module, which does not pickle
+    again = pickle.loads(pickle.dumps(registry))
+    assert again.defaults == registry.defaults and again.plates == registry.plates
+    assert again.procedure("calibration") is registry.procedure("calibration")

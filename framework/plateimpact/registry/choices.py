@@ -31,6 +31,11 @@ class Choices:
         self._procedures: dict[str, Callable[[], Any]] = {}  # name -> loader
         self._loaded: dict[str, Any] = {}
 
+    def __getstate__(self) -> dict[str, Any]:
+        # A registry travels with its simulation to a worker process: the procedures go as
+        # their loaders, never as what was loaded (a module does not pickle).
+        return {**self.__dict__, "_loaded": {}}
+
     def _save_choices(self) -> tuple[Any, ...]:
         return dict(self._defaults), dict(self._plates), self._sphere, dict(self._procedures)
 
