@@ -21,8 +21,8 @@ from ..model.bodies import Plate, Sphere
 
 
 class Choices:
-    """Defaults, presets and the default sphere of a :class:`PluginRegistry`, with who
-    declared each (for the one-line refusal of a second claim)."""
+    """Defaults, presets, the default sphere and procedures of a :class:`PluginRegistry`;
+    for a default, the module that declared it (named when a second claim is refused)."""
 
     def __init__(self) -> None:
         self._defaults: dict[str, tuple[str, str]] = {}  # kind -> (name, module)
