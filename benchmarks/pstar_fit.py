@@ -36,7 +36,7 @@ import numpy as np
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.model.results import Outcome
-from plateimpact_plugins import PstarTable
+from plateimpact_plugins import PstarTable, report
 
 SPEED_SIGMA, RESIDUAL_SIGMA = 10.0, 5.0  # [m/s]
 SPHERE = presets.DEFAULT_SPHERE
@@ -92,8 +92,8 @@ def pstar_only(seeds: int) -> None:
     z, relative, seconds = [], [], []
     for seed in range(seeds):
         data = shots(simulation, ALUMINIUM, groups, seed)
-        fit, spent = timed(pi.fit_pstar, data, ALUMINIUM, simulation=simulation)
-        assert isinstance(fit, pi.PstarFit)
+        fit, spent = timed(report.fit_pstar, data, ALUMINIUM, simulation=simulation)
+        assert isinstance(fit, report.PstarFit)
         z.append((fit.pstar - 3e-3) / fit.pstar_stderr)
         relative.append(fit.pstar_stderr / 3e-3)
         seconds.append(spent)
@@ -114,8 +114,8 @@ def with_alpha(seeds: int) -> None:
     zp, za, relative, relative_alpha, seconds = [], [], [], [], []
     for seed in range(seeds):
         data = shots(simulation, ALUMINIUM, groups, 100 + seed)
-        fit, spent = timed(pi.fit_pstar, data, start, simulation=simulation, fit_alpha=True)
-        assert isinstance(fit, pi.PstarFit)
+        fit, spent = timed(report.fit_pstar, data, start, simulation=simulation, fit_alpha=True)
+        assert isinstance(fit, report.PstarFit)
         e = fit.estimate
         zp.append((e.pstar - 3e-3) / e.pstar_stderr)
         za.append((e.alpha - math.radians(45.0)) / e.alpha_stderr)
@@ -146,9 +146,9 @@ def table(seeds: int) -> None:
         data = shots(made_by, STEEL, groups, 200 + seed)
         model = pi.ProbabilityModel(residual_sigma=RESIDUAL_SIGMA)
         fit, spent = timed(
-            pi.fit_pstar_by_obliquity, data, STEEL, simulation=simulation, model=model
+            report.fit_pstar_by_obliquity, data, STEEL, simulation=simulation, model=model
         )
-        assert isinstance(fit, pi.PstarTableFit)
+        assert isinstance(fit, report.PstarTableFit)
         parts = []
         for row in fit.rows:
             degrees = round(math.degrees(row.obliquity), 6)

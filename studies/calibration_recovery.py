@@ -23,6 +23,7 @@ import numpy as np
 
 import plateimpact as pi
 from plateimpact import presets
+from plateimpact_plugins import report
 
 SPHERE = presets.DEFAULT_SPHERE
 FIT = pi.Simulation.from_names(integrator_settings={"rtol": 1e-8})
@@ -49,12 +50,12 @@ def main() -> None:
     for name, speeds in SPEEDS.items():
         plate = presets.plate(name)
         shots = pi.synthetic_shots(plate, SPHERE, speeds, simulation=DATA)
-        newton = pi.newton_fit(shots, plate, simulation=FIT)
-        direct = pi.direct_fit(shots, plate, simulation=FIT)
+        newton = report.newton_fit(shots, plate, simulation=FIT)
+        direct = report.direct_fit(shots, plate, simulation=FIT)
         dri = pi.fit_dri(shots.impact_speed, shots.residual_speed)
         volume = math.pi * SPHERE.radius**2 * plate.thickness
-        start = pi.energy_balance_start(dri.R, dri.V0, SPHERE, plate, volume=volume)
-        thick = pi.newton_fit(shots, plate, simulation=FIT, start=start)
+        start = report.energy_balance_start(dri.R, dri.V0, SPHERE, plate, volume=volume)
+        thick = report.newton_fit(shots, plate, simulation=FIT, start=start)
         print(
             f"  {name:13s} newton a {abs(newton.a / plate.a - 1):.1e} b "
             f"{abs(newton.b / plate.b - 1):.1e} | direct a {abs(direct.a / plate.a - 1):.1e} "
@@ -70,8 +71,8 @@ def main() -> None:
                 plate, SPHERE, speeds, noise=args.noise, seed=seed, simulation=DATA
             )
             fits = [
-                pi.newton_fit(shots, plate, simulation=FIT),
-                pi.direct_fit(shots, plate, simulation=FIT),
+                report.newton_fit(shots, plate, simulation=FIT),
+                report.direct_fit(shots, plate, simulation=FIT),
             ]
             z.append([(f.a - plate.a) / f.a_stderr for f in fits])
             z[-1] += [(f.b - plate.b) / f.b_stderr for f in fits]

@@ -33,6 +33,7 @@ from plateimpact.provenance.code import plugins_record
 from plateimpact.provenance.metadata import versions
 from plateimpact.provenance.source_hash import module_sources, source_sha256
 from plateimpact.storage.output import write_text
+from plateimpact_plugins.report import fit_pstar_by_obliquity
 
 DATA = Path(__file__).resolve().parent / "data"
 PLATE = "SAE1010/1.47"
@@ -145,7 +146,7 @@ def experiment(
             groups = shots.groups_by_obliquity()
             nearest = min(groups, key=lambda o: abs(math.degrees(o) - QUICK_FIT_OBLIQUITY))
             fitting = groups[nearest]
-        fitted = pi.fit_pstar_by_obliquity(fitting, plate, sphere=sphere, **finder)
+        fitted = fit_pstar_by_obliquity(fitting, plate, sphere=sphere, **finder)
         write_text(table, fitted.csv_text(), "table")
     write_text(written, json.dumps(record, indent=1, sort_keys=True) + "\n", "provenance", "json")
     return outputs(out, suffix)

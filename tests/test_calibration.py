@@ -17,8 +17,9 @@ import pytest
 
 import plateimpact as pi
 from plateimpact import presets
-from plateimpact.calibration import swept_volume
 from plateimpact.cli import main
+from plateimpact_plugins import report
+from plateimpact_plugins.report import fits as _fits
 
 SPHERE = presets.DEFAULT_SPHERE
 FIT = pi.Simulation.from_names(integrator_settings={"rtol": 1e-8})
@@ -55,7 +56,7 @@ def dri_shots(R: float, V0: float, speeds: np.ndarray) -> pi.Shots:
     )
 
 
-def relative_error(fit: pi.Calibration, plate: pi.Plate) -> tuple[float, float]:
+def relative_error(fit: report.Calibration, plate: pi.Plate) -> tuple[float, float]:
     return abs(fit.a / plate.a - 1), abs(fit.b / plate.b - 1)
 
 
@@ -98,7 +99,7 @@ def test_model_at_normal_incidence_is_the_dri_form_of_the_energy_balance(plate_n
     # The model integrates eqs 25-30 with its own geometry and plugging; the closed form
     # a + b Vr² = (a + b Vs²) exp(-2bW/m) of docs/calibration.md must agree with it.
     plate = presets.plate(plate_name)
-    R = math.exp(-plate.b * swept_volume(SPHERE, plate) / SPHERE.mass)
+    R = math.exp(-plate.b * report.swept_volume(SPHERE, plate) / SPHERE.mass)
     V0 = math.sqrt(plate.a / plate.b * (1 / R**2 - 1))
     speeds = np.linspace(1.05 * V0, 1500.0, 8)
     result = pi.Simulation.from_names().run_batch(
@@ -107,7 +108,7 @@ def test_model_at_normal_incidence_is_the_dri_form_of_the_energy_balance(plate_n
     assert np.all(result.outcome == pi.Outcome.PERFORATION)
     closed_form = R * np.sqrt(speeds**2 - V0**2)
     assert np.max(np.abs(result.exit_speed - closed_form) / speeds) < 1e-6
-    assert pi.energy_balance_start(R, V0, SPHERE, plate) == pytest.approx((plate.a, plate.b))
+    assert report.energy_balance_start(R, V0, SPHERE, plate) == pytest.approx((plate.a, plate.b))
 
 
 # ---------------------------------------------------------------- Newton and direct
@@ -116,14 +117,14 @@ def test_model_at_normal_incidence_is_the_dri_form_of_the_energy_balance(plate_n
 @pytest.mark.parametrize("plate_name", list(presets.PLATES))
 def test_both_methods_recover_table_1_from_noise_free_shots(plate_name):
     plate, shots = presets.plate(plate_name), shots_of(plate_name)
-    newton = pi.newton_fit(shots, plate, simulation=FIT)
-    direct = pi.direct_fit(shots, plate, simulation=FIT)
+    newton = report.newton_fit(shots, plate, simulation=FIT)
+    direct = report.direct_fit(shots, plate, simulation=FIT)
     assert max(relative_error(newton, plate)) < 1e-3
     assert max(relative_error(direct, plate)) < 1e-3
     # From the documented start (exact for plugging at normal incidence: tested above)
     # what is left is integrator error; studies/calibration_recovery.py counts the steps.
     assert newton.converged
-    assert newton.dri_mismatch < pi.calibration.NEWTON_TOLERANCE
+    assert newton.dri_mismatch < _fits.NEWTON_TOLERANCE
 
 
 @pytest.mark.parametrize("plate_name", list(presets.PLATES))
@@ -132,11 +133,11 @@ def test_newton_converges_from_the_thickness_reading_of_eqs_42_43(plate_name):
     # 10-170 % off Table 1 for these plates: the iteration has real work to do.
     plate, shots = presets.plate(plate_name), shots_of(plate_name)
     dri = pi.fit_dri(shots.impact_speed, shots.residual_speed)
-    start = pi.energy_balance_start(
+    start = report.energy_balance_start(
         dri.R, dri.V0, SPHERE, plate, volume=math.pi * SPHERE.radius**2 * plate.thickness
     )
     assert max(abs(start[0] / plate.a - 1), abs(start[1] / plate.b - 1)) > 0.05
-    newton = pi.newton_fit(shots, plate, simulation=FIT, start=start)
+    newton = report.newton_fit(shots, plate, simulation=FIT, start=start)
     assert newton.converged and newton.iterations >= 1
     assert max(relative_error(newton, plate)) < 1e-3
 
@@ -147,7 +148,7 @@ def test_newton_corrects_the_start_for_the_hinge_failure_model():
     plate = presets.plate("SAE1010/1.47")
     hinge = pi.Simulation.from_names(failure="hinge", integrator_settings={"rtol": 1e-8})
     shots = shots_of("SAE1010/1.47", failure="hinge")
-    newton = pi.newton_fit(shots, plate, simulation=hinge)
+    newton = report.newton_fit(shots, plate, simulation=hinge)
     assert newton.converged and newton.iterations >= 1
     assert max(relative_error(newton, plate)) < 1e-3
 
@@ -156,8 +157,8 @@ def test_newton_corrects_the_start_for_the_hinge_failure_model():
 def test_both_methods_recover_table_1_within_their_uncertainty_at_2_percent_noise(plate_name):
     plate, shots = presets.plate(plate_name), shots_of(plate_name, noise=0.02, seed=7)
     for fit in (
-        pi.newton_fit(shots, plate, simulation=FIT),
-        pi.direct_fit(shots, plate, simulation=FIT),
+        report.newton_fit(shots, plate, simulation=FIT),
+        report.direct_fit(shots, plate, simulation=FIT),
     ):
         assert abs(fit.a - plate.a) < 3 * fit.a_stderr, fit.method
         assert abs(fit.b - plate.b) < 3 * fit.b_stderr, fit.method
@@ -170,7 +171,7 @@ def test_shots_no_a_b_can_fit_are_reported_in_one_line():
     # Residual speeds rising faster than impact speed (R = 1.05): every b > 0 gives R < 1.
     shots = dri_shots(1.05, 300.0, np.linspace(320.0, 1500.0, 12))
     with pytest.raises(pi.ConvergenceError) as caught:
-        pi.newton_fit(shots, presets.plate("2024-T3/3.18"), simulation=FIT)
+        report.newton_fit(shots, presets.plate("2024-T3/3.18"), simulation=FIT)
     message = str(caught.value)
     assert "\n" not in message and "R >= 1" in message and "Newton" in message
     assert isinstance(caught.value, pi.PlateImpactError)
@@ -180,9 +181,9 @@ def test_newton_stops_at_max_iterations_with_one_line():
     plate, shots = presets.plate("SAE1010/1.47"), shots_of("SAE1010/1.47")
     far = (3 * plate.a, 3 * plate.b)
     with pytest.raises(pi.ConvergenceError, match="no convergence in 1 iterations") as caught:
-        pi.newton_fit(shots, plate, simulation=FIT, start=far, max_iterations=1)
+        report.newton_fit(shots, plate, simulation=FIT, start=far, max_iterations=1)
     assert "\n" not in str(caught.value)
-    last = pi.newton_fit(
+    last = report.newton_fit(
         shots, plate, simulation=FIT, start=far, max_iterations=1, raise_on_failure=False
     )
     assert not last.converged and last.iterations == 1 and last.dri_mismatch > 1e-6

@@ -75,7 +75,7 @@ def test_cli_run_is_the_python_api(options, plate_changes, model, capsys):
     plate = presets.plate("2024-T3/6.35").with_constants(**plate_changes)
     sphere = presets.DEFAULT_SPHERE
     if "--radius" in options:  # a new radius keeps the default sphere's density
-        sphere = pi.Sphere.of_density(2.5e-3, presets.SAE_52100_DENSITY)
+        sphere = pi.Sphere.of_density(2.5e-3, presets.SPHERE_DENSITY)
     simulation = pi.Simulation.from_names(**model)
     expected = simulation.run(pi.Scene(sphere, plate, 500.0, np.radians(30.0)))
     for key, value in expected.as_user_dict().items():

@@ -53,16 +53,20 @@ def sha256_of_modules(modules: dict[str, Path]) -> str:
 
 def isotropic_sha256(site: Path) -> str:
     """The rate law's source hash, from the rule: its module (the package's __init__), the
-    package's modules that imports (its failure model and integrator), and what it imports
-    from the built-ins' package by name, plateimpact_plugins, whose __init__ imports every
-    built-in module."""
-    modules = {PACKAGE: site / PACKAGE / "__init__.py"}
+    package's modules that imports (its failure model and integrator), what they import
+    from the built-ins' package by name, plateimpact_plugins.report, and what that imports
+    (its constants, the failure plane, the P* table), with the enclosing package's
+    __init__ (not followed: the built-in plug-ins themselves)."""
+    modules = {
+        PACKAGE: site / PACKAGE / "__init__.py",
+        "plateimpact_plugins": BUILTINS / "__init__.py",
+        "plateimpact_plugins.report": BUILTINS / "report" / "__init__.py",
+    }
     for path in (site / PACKAGE).glob("*.py"):
         if path.stem != "__init__":
             modules[f"{PACKAGE}.{path.stem}"] = path
-    for path in BUILTINS.glob("*.py"):
-        stem = "" if path.stem == "__init__" else f".{path.stem}"
-        modules[f"plateimpact_plugins{stem}"] = path
+    for stem in ("constants", "plane", "pstar_table"):
+        modules[f"plateimpact_plugins.report.{stem}"] = BUILTINS / "report" / f"{stem}.py"
     return sha256_of_modules(modules)
 
 
@@ -226,7 +230,8 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
         files = {m: Path(importlib.util.find_spec(m).origin) for m in entry["source_modules"]}
         assert entry["source_sha256"] == sha256_of_modules(files)
     assert record["failure"]["source_modules"] == [
-        "plateimpact_plugins", "plateimpact_plugins.hinge", "plateimpact_plugins.plate_constants",
+        "plateimpact_plugins", "plateimpact_plugins.hinge", "plateimpact_plugins.report",
+        "plateimpact_plugins.report.constants", "plateimpact_plugins.report.plane",
         "plateimpact_plugins.separation",
     ]  # fmt: skip
     assert record["integrator"]["class"] == "plateimpact_plugins.segment.Segment"
@@ -351,8 +356,9 @@ def test_experiment_outputs_are_kept_only_while_their_recorded_code_is_current(
     def computed(*args, **kwargs):
         raise Computed
 
-    for name in ("validate", "fit_v50", "fit_pstar_by_obliquity"):
+    for name in ("validate", "fit_v50"):
         monkeypatch.setattr(pi, name, computed)
+    monkeypatch.setattr(experiment, "fit_pstar_by_obliquity", computed)  # the report room's
     monkeypatch.setattr(limits, "along_speed", computed)
     assert experiment.experiment(tmp_path, resume=True) == made  # all kept, nothing computed
     assert all(p.read_text() == f"made before: {p.name}" for p in made)

@@ -16,10 +16,11 @@ from test_output_files import assert_one_line, run_cli
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.base.errors import WorkBoundError
-from plateimpact.calibration import pstar_plan, pstar_search
-from plateimpact.calibration.outcome_model import ProbabilityModel, ShotLines
+from plateimpact.calibration import ProbabilityModel, ShotLines
 from plateimpact.limits import chunked
 from plateimpact.model.results import Outcome
+from plateimpact_plugins import report
+from plateimpact_plugins.report import pstar_plan, pstar_search
 
 PLATE = presets.plate("2024-T3/3.18")
 FAST = {"resolution": 4.0, "tolerance": 0.25}
@@ -75,7 +76,7 @@ def test_one_fittable_range_at_each_obliquity_is_enough_to_go_on(tmp_path, no_sc
     rows = [(v, o, outcome) for o in (30, 60) for v, outcome in
             ((500, "embedment"), (600, "perforation"), (700, "perforation"))]  # fmt: skip
     with pytest.raises(SceneRan):
-        pi.fit_pstar_by_obliquity(pi.Shots.from_csv(csv_of(rows, tmp_path)), PLATE, **FAST)
+        report.fit_pstar_by_obliquity(pi.Shots.from_csv(csv_of(rows, tmp_path)), PLATE, **FAST)
 
 
 def test_a_set_that_plainly_cannot_fix_pstar_is_told_from_its_shots():
@@ -117,7 +118,7 @@ def test_the_estimate_is_the_scan_of_every_line_times_the_candidates():
          "impact_obliquity_deg": [r[1] for r in aluminium_rows()],
          "outcome": [r[2] for r in aluminium_rows()]}
     )  # fmt: skip
-    from plateimpact.calibration.pstar import prepare
+    from plateimpact_plugins.report.pstar_fits import prepare
 
     prepared = prepare(shots, presets.DEFAULT_SPHERE, "outcome", ProbabilityModel())
     assert prepared.lines is not None
@@ -128,15 +129,15 @@ def test_the_estimate_is_the_scan_of_every_line_times_the_candidates():
 @pytest.mark.parametrize("by_obliquity", [False, True])
 def test_a_fit_over_its_bound_is_refused_before_any_scene(tmp_path, no_scene, by_obliquity):
     shots = pi.Shots.from_csv(csv_of(aluminium_rows(), tmp_path))
-    fit = pi.fit_pstar_by_obliquity if by_obliquity else pi.fit_pstar
+    fit = report.fit_pstar_by_obliquity if by_obliquity else report.fit_pstar
     with pytest.raises(WorkBoundError) as info:
         fit(shots, PLATE, max_scenes=1000, **FAST)
     assert "more than 1,000" in str(info.value) and "--force" in str(info.value)
     if not by_obliquity:  # alpha* multiplies the candidates by (27 + 118) / 27
         with pytest.raises(WorkBoundError, match="about 26,970 scenes"):
-            pi.fit_pstar(shots, PLATE, max_scenes=186 * 27, fit_alpha=True, **FAST)
+            report.fit_pstar(shots, PLATE, max_scenes=186 * 27, fit_alpha=True, **FAST)
         with pytest.raises(SceneRan):  # within the bound without alpha*: it starts
-            pi.fit_pstar(shots, PLATE, max_scenes=186 * 27, **FAST)
+            report.fit_pstar(shots, PLATE, max_scenes=186 * 27, **FAST)
 
 
 #: Shots on one line (45 deg, 430-530 m/s), and a coarse finder: a fit of a few seconds.
@@ -171,7 +172,7 @@ def test_a_fit_runs_a_chunk_at_a_time_and_keeps_no_samples_per_candidate(tmp_pat
     model = ProbabilityModel(10.0, residual_sigma=5.0)
     told: list[int] = []
     monkeypatch.setattr("plateimpact.run.simulation.report_scenes", told.append)
-    whole = pi.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
+    whole = report.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
     assert whole.residual_shots == 4
     assert max(told) == 17 * 34  # the scan of 17 candidates, one batch
     told.clear()
@@ -192,7 +193,7 @@ def test_a_fit_runs_a_chunk_at_a_time_and_keeps_no_samples_per_candidate(tmp_pat
         return likelihood(shots, bands, model)
 
     monkeypatch.setattr(pstar_search, "log_likelihood", counting)
-    parts = pi.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
+    parts = report.fit_pstar(shots, PLATE, simulation=simulation, model=model, **COARSE)
     assert max(told) == 100 and told[:6] == [100] * 5 + [78]  # the scan, chunked
     assert (parts.pstar, parts.pstar_stderr) == (whole.pstar, whole.pstar_stderr)
     (search,) = memos  # the samples served the likelihood and were dropped
@@ -215,4 +216,4 @@ def test_more_obliquities_than_a_table_takes_are_refused_before_grouping(
     with pytest.raises(
         pi.CalibrationError, match="shots at 1,001 obliquities, more than the 1,000"
     ):
-        pi.fit_pstar_by_obliquity(shots, PLATE, **FAST)
+        report.fit_pstar_by_obliquity(shots, PLATE, **FAST)

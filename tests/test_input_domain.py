@@ -16,10 +16,11 @@ import numpy as np
 import pytest
 
 import plateimpact as pi
-from plateimpact import calibration, presets
-from plateimpact.calibration.start import log_domain
+from plateimpact import presets
 from plateimpact.cli import main
 from plateimpact.solve import driver
+from plateimpact_plugins import report
+from plateimpact_plugins.report.ab_start import log_domain
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/3.18")
@@ -358,7 +359,7 @@ def test_corners_of_the_domain_run_without_runtime_warnings(integrator, settings
     assert np.all(np.isfinite(result.exit_speed))
 
 
-@pytest.mark.parametrize("fit", [calibration.newton_fit, calibration.direct_fit])
+@pytest.mark.parametrize("fit", [report.newton_fit, report.direct_fit])
 def test_calibration_never_runs_the_model_outside_its_range(fit):
     shots = pi.Shots.from_csv(SHOTS)
     with pytest.raises(pi.CalibrationError, match=r"start a = 1 N/m\^2.*outside the model's"):

@@ -262,8 +262,7 @@ def test_a_mass_no_gram_value_reaches_is_recorded_in_kg(tmp_path, capsys):
     radius = next(
         r
         for r in np.round(np.arange(2.0, 4.0, 0.01), 2)
-        if MASS.user_number(pi.Sphere.of_density(r * 1e-3, pi.presets.SAE_52100_DENSITY).mass)
-        is None
+        if MASS.user_number(pi.Sphere.of_density(r * 1e-3, pi.presets.SPHERE_DENSITY).mass) is None
     )
     first = run_json(capsys, *RUN, "--radius", str(radius))
     sphere = json.loads(first)["inputs"]["sphere"]

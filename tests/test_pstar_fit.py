@@ -15,8 +15,7 @@ from scipy import integrate, stats
 
 import plateimpact as pi
 from plateimpact import limits, presets
-from plateimpact.calibration import pstar, pstar_search
-from plateimpact.calibration.model_lines import Cost
+from plateimpact.calibration import Cost
 from plateimpact.calibration.outcome_model import (
     OUTCOME_BLUNDER,
     Bands,
@@ -26,10 +25,13 @@ from plateimpact.calibration.outcome_model import (
     allowed_outcomes,
     log_likelihood,
 )
-from plateimpact.calibration.pstar_search import PstarEstimate
-from plateimpact.cli import calibrate_pstar, main
+from plateimpact.cli import main
 from plateimpact.model.results import Outcome
 from plateimpact.storage import output
+from plateimpact_plugins.report import fits as report_fits
+from plateimpact_plugins.report import pstar_fits as pstar
+from plateimpact_plugins.report import pstar_search
+from plateimpact_plugins.report.pstar_search import PstarEstimate
 from plateimpact_plugins.variable_pstar import TABLE_COLUMNS, PstarTable
 
 RIC, EMB, PERF = (1 << int(o) for o in Outcome)
@@ -310,8 +312,8 @@ def test_a_full_disk_at_out_keeps_the_old_file(
     fit = pstar.PstarFit(plate, estimate, False, model, 24, 0, "", cost)
     row = pstar.PstarRow(math.radians(45.0), estimate, estimate, 10, 10, 400.0, 450.0, ())
     table = pstar.PstarTableFit((row,), math.radians(45.0), model, cost)
-    monkeypatch.setattr(calibrate_pstar, "fit_pstar", lambda *args, **kwargs: fit)
-    monkeypatch.setattr(calibrate_pstar, "fit_pstar_by_obliquity", lambda *a, **k: table)
+    monkeypatch.setattr(report_fits, "fit_pstar", lambda *args, **kwargs: fit)
+    monkeypatch.setattr(report_fits, "fit_pstar_by_obliquity", lambda *a, **k: table)
     target = tmp_path / ("table.csv" if by_obliquity else "plate.json")
     target.write_text("what was there\n")
 

@@ -23,11 +23,13 @@ FORMAT1 = Path(__file__).parent / "data" / "format1.h5"
 #: line's main (it builds the one registry of a command), and the API's entry points.
 ENTRY_POINTS = {
     "registry/plugin_registry.py": {"default_registry"},
-    "__init__.py": {"<module>", "__dir__"},
+    "__init__.py": {"<module>", "__dir__", "__getattr__"},  # the moved names, deprecated
     "cli/__init__.py": {"build_parser", "main"},
+    "registry/presets.py": {"plate", "__getattr__"},  # pi.presets: the installed presets
     "run/simulation.py": {"Simulation", "Simulation.from_names"},
+    "run/variant.py": {"Variant", "Variant.__attrs_post_init__"},  # default plug-ins
     "storage/plate_file.py": {"load_plate_file", "save_plate_file"},
-    "study/study.py": {"StudyResults.to_xarray"},
+    "study/study.py": {"Study.grid", "StudyResults.to_xarray"},  # preset names, sphere
 }
 
 
@@ -70,8 +72,18 @@ def no_global(monkeypatch):
     def refuse() -> pi.PluginRegistry:
         raise AssertionError("the library reached for the global registry")
 
+    import importlib
     import sys
 
+    # Every module that names it imported first: one imported while it is replaced would
+    # keep the replacement after the test.
+    for where in ENTRY_POINTS:
+        importlib.import_module(
+            ".".join(
+                ["plateimpact", *where.split("/")[:-1]]
+                + ([] if where.endswith("__init__.py") else [where.split("/")[-1][:-3]])
+            )
+        )
     for name, module in list(sys.modules.items()):
         if name.startswith("plateimpact") and hasattr(module, "default_registry"):
             monkeypatch.setattr(module, "default_registry", refuse)
@@ -88,10 +100,13 @@ def test_the_library_runs_on_an_explicit_registry_alone(no_global, tmp_path, sph
     from plateimpact.storage.upgrade import upgrade
 
     registry = no_global
-    plate = pi.presets.plate("2024-T3/3.18")
+    plate = registry.plate("2024-T3/3.18")  # the presets are the registry's
     simulation = pi.Simulation.from_names(registry=registry)
     assert simulation.registry is registry
-    study = pi.Study.grid("s", [plate], [0.0, 45.0], [400.0, 900.0], pi.Variant("v"))
+    # a Variant naming no plug-in takes the installed defaults: name them from this one
+    names = [registry.default(kind) for kind in ("resistance", "failure", "integrator")]
+    variant = pi.Variant("v", *names)
+    study = pi.Study.grid("s", [plate], [0.0, 45.0], [400.0, 900.0], variant, registry=registry)
     archive = tmp_path / "a.h5"
     assert len(study.run(archive=archive, registry=registry)["v"]) == 4
     run = pi.Archive(archive).runs()[0]

@@ -11,6 +11,7 @@ import pytest
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.units import deg, g, mm
+from plateimpact_plugins import report
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/1.27")
@@ -213,7 +214,7 @@ def test_calibration_uses_only_normal_shots_with_a_residual_speed():
     )
     assert list(normal.perforated) == [False, True, True, True]
     with pytest.raises(pi.ShotDataError, match="2 perforating shots at normal incidence"):
-        pi.newton_fit(normal, presets.plate("2024-T3/3.18"))
+        report.newton_fit(normal, presets.plate("2024-T3/3.18"))
 
 
 def test_the_fits_of_a_and_b_refuse_per_shot_spheres_and_weights_rather_than_ignore_them():
@@ -223,7 +224,7 @@ def test_the_fits_of_a_and_b_refuse_per_shot_spheres_and_weights_rather_than_ign
             f"{HEADER},residual_speed_m_s,{column}\n" + rows.format(value), source="s.csv"
         )
         with pytest.raises(pi.ShotDataError, match=r"^s.csv line 2: the fits of a and b take"):
-            pi.newton_fit(shots, presets.plate("2024-T3/3.18"))
+            report.newton_fit(shots, presets.plate("2024-T3/3.18"))
 
 
 def test_shots_built_in_python_need_one_entry_per_shot():

@@ -16,6 +16,8 @@ from plateimpact import limits, presets
 from plateimpact.base.errors import WorkBoundError
 from plateimpact.limits import bracketing as finder
 from plateimpact.limits import chunked
+from plateimpact_plugins import report
+from plateimpact_plugins.report import fits as _fits
 
 SPHERE = presets.DEFAULT_SPHERE
 PLATE = presets.plate("2024-T3/1.27")
@@ -155,7 +157,7 @@ def test_the_ab_fit_is_bounded_before_any_scene_by_its_normal_shots(no_scene, mo
     shots = pi.Shots.from_csv(ROOT / NORMAL)
     plate = presets.plate("2024-T3/3.18")
     with pytest.raises(WorkBoundError, match=r"up to 3,195 scenes .* more than 3,194"):
-        pi.calibration.calibrate(shots, plate, max_scenes=3194)
+        report.calibrate(shots, plate, max_scenes=3194)
     monkeypatch.setattr("plateimpact.cli.commands.calibrate.MAX_FIT_SCENES", 3194)
     argv = ["calibrate", str(ROOT / NORMAL), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
     code, _, err = run_cli(argv)
@@ -166,10 +168,10 @@ def test_the_model_residual_speeds_run_a_chunk_at_a_time_bit_for_bit(monkeypatch
     simulation = pi.Simulation.from_names()
     plate = presets.plate("2024-T3/3.18")
     speeds, constants = np.linspace(300.0, 900.0, 7), [(1e9, 1200.0), (1.1e9, 1300.0)]
-    whole = pi.calibration.model_residual_speeds(simulation, SPHERE, plate, speeds, constants)
+    whole = _fits.model_residual_speeds(simulation, SPHERE, plate, speeds, constants)
     assert batches == [14]
     monkeypatch.setattr(chunked, "RUN_CHUNK", 3)
-    parts = pi.calibration.model_residual_speeds(simulation, SPHERE, plate, speeds, constants)
+    parts = _fits.model_residual_speeds(simulation, SPHERE, plate, speeds, constants)
     assert max(batches[1:]) <= 3
     np.testing.assert_array_equal(parts, whole)
     assert (whole > 0).any() and (whole == 0).any()

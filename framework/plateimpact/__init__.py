@@ -93,19 +93,9 @@ _EXPORTS: dict[str, str] = {
     "Study": "study",
     "StudyResults": "study",
     "Comparison": "comparison",
-    "Calibration": "calibration",
-    "CalibrationReport": "calibration",
     "DriFit": "calibration",
-    "calibrate": "calibration",
-    "direct_fit": "calibration",
-    "energy_balance_start": "calibration",
     "fit_dri": "calibration",
-    "newton_fit": "calibration",
     "ProbabilityModel": "calibration",
-    "PstarFit": "calibration",
-    "PstarTableFit": "calibration",
-    "fit_pstar": "calibration",
-    "fit_pstar_by_obliquity": "calibration",
     "validate": "experiment",
     "ValidationReport": "experiment",
     "V50Fit": "v50",
@@ -121,6 +111,7 @@ _EXPORTS: dict[str, str] = {
     "ShotDataError": "base.errors",
     "PlateFileError": "base.errors",
     "CalibrationError": "base.errors",
+    "WorkBoundError": "base.errors",
     "ConvergenceError": "base.errors",
     "V50Error": "base.errors",
     "PluginError": "base.errors",
@@ -139,10 +130,29 @@ _SUBMODULES: dict[str, str] = {
     "experiment": "experiment",
     "geometry": "model.geometry",
     "limits": "limits",
-    "presets": "model.presets",
+    "presets": "registry.presets",
     "units": "units",
     "v50": "v50",
 }
+
+#: Names the report's calibration provided here until it moved to the plug-in package
+#: that registers it as the ``calibration`` procedure (issue 22): still found, through
+#: the registry, with a DeprecationWarning naming their new module, for one release.
+_PROCEDURE_NAMES: dict[str, str] = dict.fromkeys(
+    (
+        "Calibration",
+        "CalibrationReport",
+        "calibrate",
+        "direct_fit",
+        "energy_balance_start",
+        "newton_fit",
+        "PstarFit",
+        "PstarTableFit",
+        "fit_pstar",
+        "fit_pstar_by_obliquity",
+    ),
+    "calibration",
+)
 
 __all__ = sorted([*_EXPORTS, *_SUBMODULES, "__version__"])
 
@@ -152,6 +162,18 @@ def __getattr__(name: str) -> Any:
         value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
     elif name in _SUBMODULES:
         value = importlib.import_module(f".{_SUBMODULES[name]}", __name__)
+    elif name in _PROCEDURE_NAMES:
+        import warnings  # noqa: PLC0415
+
+        from .registry.plugin_registry import default_registry  # noqa: PLC0415
+
+        procedure = default_registry().procedure(_PROCEDURE_NAMES[name])
+        warnings.warn(
+            f"plateimpact.{name} is deprecated: import it from {procedure.__name__}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(procedure, name)  # not cached: each use warns
     elif name == "__version__":
         from importlib.metadata import PackageNotFoundError, version  # noqa: PLC0415
 
@@ -186,28 +208,15 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         ShotDataError,
         UnknownNameError,
         V50Error,
+        WorkBoundError,
     )
     from .base.parameters import Parameter, Range
     from .base.untrusted import check_input, load_json, printable
-    from .calibration import (
-        Calibration,
-        CalibrationReport,
-        DriFit,
-        ProbabilityModel,
-        PstarFit,
-        PstarTableFit,
-        calibrate,
-        direct_fit,
-        energy_balance_start,
-        fit_dri,
-        fit_pstar,
-        fit_pstar_by_obliquity,
-        newton_fit,
-    )
+    from .calibration import DriFit, ProbabilityModel, fit_dri
     from .comparison import Comparison
     from .experiment import ValidationReport, validate
     from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots
-    from .model import batch, geometry, presets
+    from .model import batch, geometry
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
     from .model.events import (
@@ -242,6 +251,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .model.resistance import BoundResistance, ResistanceLaw, contact_force
     from .model.results import BatchResult, CraterSection, Outcome, Result, Trajectory
     from .model.scene import Scene
+    from .registry import presets
     from .registry.discovery import BrokenPackage
     from .registry.hookspecs import hookimpl
     from .registry.plugin_registry import PluginRegistry, default_registry, load_registry

@@ -9,7 +9,7 @@ import numpy as np
 
 from plateimpact import Column, Contact, Parameter, Range, SceneBatch
 
-from .plate_constants import CRITICAL_PENETRATION, FAILURE_ANGLE
+from .report.constants import CRITICAL_PENETRATION, FAILURE_ANGLE
 from .separation import PlaneSeparation
 
 HALF_PI = 0.5 * np.pi

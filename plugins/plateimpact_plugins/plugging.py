@@ -9,7 +9,7 @@ import numpy as np
 
 from plateimpact import SceneBatch
 
-from .plate_constants import CRITICAL_PENETRATION, FAILURE_ANGLE
+from .report.constants import CRITICAL_PENETRATION, FAILURE_ANGLE
 from .separation import PlaneSeparation
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from plateimpact import ResistanceLaw, SceneBatch
 
-from .plate_constants import DENSITY_B, STRENGTH_A
+from .report.constants import DENSITY_B, STRENGTH_A
 
 
 def poncelet_stress(speed: Any, incidence: Any, a: Any, b: Any) -> Any:

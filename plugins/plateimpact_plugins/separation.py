@@ -9,7 +9,8 @@ import numpy as np
 
 from plateimpact import Column, Contact, FailureModel, Parameter, SceneBatch, geometry
 
-from .plate_constants import FAILURE_ANGLE
+from .report.constants import FAILURE_ANGLE
+from .report.plane import failure_plane_depth
 
 
 class PlaneSeparation(FailureModel):
@@ -40,8 +41,8 @@ class PlaneSeparation(FailureModel):
 
     def prepare(self, scenes: SceneBatch) -> dict[str, np.ndarray]:
         onset = self.onset_penetration(scenes)
-        ring_depth = scenes.radius * np.cos(scenes.failure_angle) + onset - scenes.radius  # eq 8
-        return {"failure_plane_depth": np.maximum(ring_depth, 0.0)}
+        depth = failure_plane_depth(scenes.radius, scenes.failure_angle, onset)  # eq 8
+        return {"failure_plane_depth": depth}
 
     def relief(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""

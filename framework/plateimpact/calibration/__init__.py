@@ -1,59 +1,71 @@
-"""Calibration of the Poncelet constants a and b from residual speeds at normal incidence.
+"""Fitting declared plate constants to shots: the tools, for any model (docs/calibration.md).
 
-Three steps, after the report's eqs 40–49 (docs/calibration.md):
+* :func:`fit_dri` — the DRI (Recht–Ipson) fit Vr = R (Vs² − V0²)^½ (eq 40) of residual
+  speeds by linear least squares of Vr² on Vs² (eq 41, M = R², B = −R² V0²);
+* :func:`model_residual_speeds` — the model's residual speeds at normal incidence for
+  candidate values of any declared plate constants, one batch; :func:`normal_shots`, the
+  shots such a fit takes; :func:`in_model_domain`, :func:`log_domain`, the ranges the
+  model declares for the constants fitted;
+* :class:`ProbabilityModel`, :func:`log_likelihood` — the probability of shots' outcomes
+  and residual speeds given the model's outcome bands along their lines, and
+  :class:`LineModel`, those bands for candidate plate constants (any names), all
+  candidates in the same batches.
 
-* :func:`fit_dri` — the DRI (Recht–Ipson) fit Vr = R (Vs² − V0²)^½ (eq 40) by linear least
-  squares of Vr² on Vs² (eq 41, M = R², B = −R² V0²);
-* :func:`newton_fit` — the report's iteration: the model is run at normal incidence at the
-  shots' impact speeds, its residual speeds fitted the same way, and a, b corrected by 2×2
-  Newton steps on the differences in R and V0 (eqs 44–49), from the energy-balance start
-  of :func:`energy_balance_start` (our repair of eqs 42–43);
-* :func:`direct_fit` — a and b by bounded nonlinear least squares of the model's residual
-  speeds to the shots.
-
-P* and α* are fixed beforehand (from craters, as in the report). Every model evaluation
-is one batch through :meth:`Simulation.run_batch`.
-
-With a and b known, :func:`fit_pstar` fits P* (and α*) to oblique shots by maximum
-likelihood of their outcomes and residual speeds (:class:`ProbabilityModel`), and
-:func:`fit_pstar_by_obliquity` the report's variable P*: a ricochet-range and a
-perforation-range P* at each obliquity, as the ``variable-pstar`` plug-in's table.
+The report's own procedure — a and b by its Newton iteration (eqs 44–49) and a direct
+fit, P* and α* from oblique shots, the variable-P* table — is the plug-in package's: the
+built-ins register it as the ``calibration`` procedure (``registry.procedure``), which
+``plateimpact calibrate`` runs.
 """
 
 from __future__ import annotations
 
 from .dri import MIN_PERFORATIONS, DriFit, fit_dri
-from .fits import (
-    DIFFERENCE_STEP,
-    NEWTON_TOLERANCE,
-    Calibration,
-    CalibrationReport,
-    calibrate,
-    direct_fit,
-    newton_fit,
+from .model_lines import GROUP_SCENES, MAX_FIT_SCENES, Cost, LineModel, check_finder, scan_scenes
+from .outcome_model import (
+    OUTCOME_BLUNDER,
+    QUESTIONS,
+    RESIDUAL_SIGMA_BOUNDS,
+    SPEED_SIGMA,
+    Bands,
+    ProbabilityModel,
+    ShotLines,
+    allowed_outcomes,
+    log_likelihood,
+    shot_lines,
 )
-from .outcome_model import ProbabilityModel
-from .pstar import PstarFit, PstarRow, PstarTableFit, fit_pstar, fit_pstar_by_obliquity
-from .start import energy_balance_start, model_residual_speeds, swept_volume
+from .residual_speeds import (
+    declared_ranges,
+    fit_model_dri,
+    in_model_domain,
+    log_domain,
+    model_residual_speeds,
+    normal_shots,
+)
 
 __all__ = [
-    "DIFFERENCE_STEP",
+    "GROUP_SCENES",
+    "MAX_FIT_SCENES",
     "MIN_PERFORATIONS",
-    "NEWTON_TOLERANCE",
-    "Calibration",
-    "CalibrationReport",
+    "OUTCOME_BLUNDER",
+    "QUESTIONS",
+    "RESIDUAL_SIGMA_BOUNDS",
+    "SPEED_SIGMA",
+    "Bands",
+    "Cost",
     "DriFit",
+    "LineModel",
     "ProbabilityModel",
-    "PstarFit",
-    "PstarRow",
-    "PstarTableFit",
-    "calibrate",
-    "direct_fit",
-    "energy_balance_start",
+    "ShotLines",
+    "allowed_outcomes",
+    "check_finder",
+    "declared_ranges",
     "fit_dri",
-    "fit_pstar",
-    "fit_pstar_by_obliquity",
+    "fit_model_dri",
+    "in_model_domain",
+    "log_domain",
+    "log_likelihood",
     "model_residual_speeds",
-    "newton_fit",
-    "swept_volume",
+    "normal_shots",
+    "scan_scenes",
+    "shot_lines",
 ]

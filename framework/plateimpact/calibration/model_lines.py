@@ -17,7 +17,7 @@ import numpy as np
 
 from ..base.errors import ParameterError
 from ..limits import locate, regime_codes
-from ..limits.bracketing import RELATIVE_FLOOR
+from ..limits.bracketing import GROUP_SCENES, RELATIVE_FLOOR, scan_intervals
 from ..limits.chunked import run_chunked
 from ..model.batch import SceneBatch
 from ..model.bodies import Plate, Sphere
@@ -31,6 +31,18 @@ from .outcome_model import Bands, ShotLines
 #: from the tolerance to 100 m/s.
 TOLERANCE_RANGE = (RELATIVE_FLOOR * IMPACT_SPEED.range.high, 10.0)
 MAX_RESOLUTION = 100.0
+#: The scenes a fit runs without being asked to run more (as a sweep, the limits and
+#: validate): about a minute and a half of scenes in one batch, several minutes in a
+#: fit's many small batches (docs/calibration.md).
+MAX_FIT_SCENES = 1_000_000
+
+__all__ = ["GROUP_SCENES", "MAX_FIT_SCENES", "Cost", "LineModel", "check_finder", "scan_scenes"]
+
+
+def scan_scenes(shots: ShotLines, resolution: float) -> int:
+    """The scan samples of the lines of one shot set, for one candidate [finder
+    resolution in m/s]."""
+    return int((scan_intervals(shots.start, shots.end, resolution) + 1).sum())
 
 
 def check_finder(resolution: float, tolerance: float) -> None:

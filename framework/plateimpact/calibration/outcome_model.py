@@ -129,8 +129,9 @@ def shot_lines(
     weight: np.ndarray,
     speed_sigma: float,
 ) -> ShotLines:
-    """Shots grouped onto lines: one per distinct (obliquity, radius, mass), each spanning
-    its shots' speeds and SPEED_MARGIN × s beyond (within the model's speed range)."""
+    """Shots grouped onto lines: one per distinct (obliquity [rad], radius [m], mass [kg]),
+    each spanning its shots' ``speed`` [m/s] and SPEED_MARGIN × s beyond (s = speed_sigma
+    [m/s]; within the model's speed range)."""
     keys = np.column_stack([obliquity, radius, mass])
     unique, line = np.unique(keys, axis=0, return_inverse=True)
     line = line.reshape(-1)

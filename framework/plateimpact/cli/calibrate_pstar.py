@@ -7,24 +7,18 @@ import argparse
 import json
 import math
 import os
-from typing import Any
+from typing import Any, TypeAlias
 
 from ..base.units import g, mm
-from ..calibration.model_lines import Cost, check_finder
-from ..calibration.outcome_model import (
+from ..calibration import (
+    MAX_FIT_SCENES,
     OUTCOME_BLUNDER,
     RESIDUAL_SIGMA_BOUNDS,
     SPEED_SIGMA,
+    Cost,
     ProbabilityModel,
+    check_finder,
 )
-from ..calibration.pstar import (
-    PstarFit,
-    PstarTableFit,
-    fit_pstar,
-    fit_pstar_by_obliquity,
-)
-from ..calibration.pstar_plan import MAX_FIT_SCENES
-from ..calibration.pstar_search import NEAR, PSTAR_RANGE, PSTAR_STEP, SCAN_POINTS, PstarEstimate
 from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
 from ..model.bodies import Plate, Sphere
 from ..provenance.metadata import versions
@@ -37,6 +31,14 @@ from .common import UsageError, check_directory, write_atomically
 from .formatting import ANGLE, user
 from .options import bodies, model_choice, typed
 from .writer import Writer
+
+#: The fits, and their search's constants, are the registered calibration procedure's
+#: (``registry.procedure("calibration")``, a plug-in package's): PstarFit, PstarTableFit
+#: and PstarEstimate are its classes.
+PstarFit: TypeAlias = Any
+PstarTableFit: TypeAlias = Any
+PstarEstimate: TypeAlias = Any
+
 
 #: The options only --fit pstar reads, with their defaults (a typed one is refused with
 #: --fit ab rather than ignored).
@@ -109,6 +111,7 @@ def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Write
     check_directory(args.out, "--out")
     shots = Shots.from_csv(args.shots)
     choice = model_choice(args, registry)
+    fits = registry.procedure("calibration")  # the report's, from its plug-in package
     simulation = choice.simulation()
     if getattr(args, "pstar", None) is not None or "critical_penetration" in choice.plate:
         flag = choice.plate_flags.get("critical_penetration", "--pstar")
@@ -139,28 +142,28 @@ def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Write
     bound = None if args.force else MAX_FIT_SCENES
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
-            table = fit_pstar_by_obliquity(
+            table = fits.fit_pstar_by_obliquity(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
                 resolution=finder["resolution"], tolerance=finder["tolerance"],
                 max_scenes=bound,
             )  # fmt: skip
         else:
-            fit = fit_pstar(
+            fit = fits.fit_pstar(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
                 fit_alpha=args.alpha_fit, resolution=finder["resolution"],
                 tolerance=finder["tolerance"], max_scenes=bound,
             )  # fmt: skip
     if args.by_obliquity:
-        summary = _table_summary(args, table, simulation, finder, sphere)
+        summary = _table_summary(fits, args, table, simulation, finder, sphere)
         if args.out is not None:
             write_atomically(args.out, table.csv_text(), "--out")
         out.say(json.dumps(summary) if args.json else _table_text(args, table))
         return
-    summary = _fit_summary(args, fit, simulation, finder, sphere)
+    summary = _fit_summary(fits, args, fit, simulation, finder, sphere)
     if args.out is not None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
         write_atomically(args.out, plate_file_text(fit.plate, extra, registry=registry), "--out")
-    out.say(json.dumps(summary) if args.json else _fit_text(args, fit))
+    out.say(json.dumps(summary) if args.json else _fit_text(fits, args, fit))
 
 
 def _finite(x: float) -> float | None:
@@ -183,11 +186,13 @@ def _probability_model(
     }
 
 
-def _search(finder: dict[str, float], cost: Cost, sphere_radius: float) -> dict[str, Any]:
+def _search(
+    fits: Any, finder: dict[str, float], cost: Cost, sphere_radius: float
+) -> dict[str, Any]:
     return {
-        "pstar_range_mm": [r * sphere_radius / mm for r in PSTAR_RANGE],
-        "scan_points": SCAN_POINTS,
-        "information_step_ln_pstar": PSTAR_STEP,
+        "pstar_range_mm": [r * sphere_radius / mm for r in fits.PSTAR_RANGE],
+        "scan_points": fits.SCAN_POINTS,
+        "information_step_ln_pstar": fits.PSTAR_STEP,
         "resolution_m_s": finder["resolution"],
         "tolerance_m_s": finder["tolerance"],
         "evaluations": cost.evaluations,
@@ -197,6 +202,7 @@ def _search(finder: dict[str, float], cost: Cost, sphere_radius: float) -> dict[
 
 
 def _fit_summary(
+    fits: Any,
     args: argparse.Namespace,
     fit: PstarFit,
     simulation: Simulation,
@@ -221,9 +227,9 @@ def _fit_summary(
         "log_likelihood": e.log_likelihood,
         "converged": True,  # a fit that does not converge is an error (exit code 2)
         "shots_near_boundary": e.near,
-        "near_boundary_speed_sigmas": NEAR,
+        "near_boundary_speed_sigmas": fits.NEAR,
         "probability_model": _probability_model(args, fit.model, e.residual_sigma),
-        "search": _search(finder, fit.cost, sphere.radius),
+        "search": _search(fits, finder, fit.cost, sphere.radius),
         "note": fit.note or None,
         "plate_file": args.out,
         "model": simulation.describe(),
@@ -245,7 +251,7 @@ def _provenance(
     }
 
 
-def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
+def _fit_text(fits: Any, args: argparse.Namespace, fit: PstarFit) -> str:
     e = fit.estimate
     model = fit.model
     if math.isnan(e.residual_sigma):
@@ -271,7 +277,7 @@ def _fit_text(args: argparse.Namespace, fit: PstarFit) -> str:
         + (" (given)" if args.speed_sigma is not None else " (default)")
         + f", {sigma}, blunder {OUTCOME_BLUNDER:g}",
         f"P* = {e.pstar / mm:.5g} ± {e.pstar_stderr / mm:.2g} mm, {alpha}",
-        f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {NEAR:g} s of a "
+        f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {fits.NEAR:g} s of a "
         f"boundary; {fit.cost.evaluations} candidates in {fit.cost.batches} batches, "
         f"{fit.cost.seconds:.1f} s",
     ]
@@ -294,6 +300,7 @@ def _estimate_json(prefix: str, e: PstarEstimate, shots: int) -> dict[str, Any]:
 
 
 def _table_summary(
+    fits: Any,
     args: argparse.Namespace,
     table: PstarTableFit,
     simulation: Simulation,
@@ -319,7 +326,7 @@ def _table_summary(
         "rows": rows,
         "probability_model": _probability_model(args, table.model, math.nan)
         | {"residual_sigma_m_s": None},
-        "search": _search(finder, table.cost, sphere.radius),
+        "search": _search(fits, finder, table.cost, sphere.radius),
         "table_file": args.out,
         "model": simulation.describe(),
     }

@@ -16,25 +16,19 @@ from typing import Any
 
 import attrs
 
+from ..base.errors import UnknownNameError
 from ..base.parameters import Parameter, json_literal
 from ..base.untrusted import load_json
-from ..model import presets
 from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
 from ..model.impact import REST_SPEED_FRACTION, ImpactModel
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..registry.plugin_registry import KINDS, PluginRegistry
-from ..run.simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from ..run.simulation import Simulation
 from ..storage.plate_file import load_plate_file
 from .common import UsageError
 
 #: The model slots ``--set`` knows besides the plug-in kinds.
 SET_SLOTS = (*KINDS, "model", "plate")
-#: The plug-in of each kind when none is named.
-DEFAULT_NAMES = {
-    "resistance": DEFAULT_RESISTANCE,
-    "failure": DEFAULT_FAILURE,
-    "integrator": DEFAULT_INTEGRATOR,
-}
 #: Which flag named which parameter, for error messages: set while arguments are read.
 TYPED_FLAGS = "_typed_flags"
 
@@ -68,7 +62,8 @@ def add_model_options(parser: argparse.ArgumentParser, registry: PluginRegistry)
     group = parser.add_argument_group(
         "model (plug-ins by name; see 'plateimpact plugins --details')"
     )
-    for kind, default in DEFAULT_NAMES.items():
+    for kind in KINDS:  # the plug-in of each kind when none is named: the registry's
+        default = registry.defaults.get(kind, "none")
         choices = ", ".join(registry.names(kind))
         # No argparse default: a command can tell a name typed from none (run --inputs).
         group.add_argument(f"--{kind}", help=f"{kind}: {choices} (default {default})")
@@ -96,7 +91,7 @@ def add_body_options(
     group.add_argument(
         "--preset",
         action="append" if many_presets else "store",
-        help=f"plate preset: {', '.join(presets.PLATES)}"
+        help=f"plate preset: {', '.join(registry.plates)}"
         + ("; repeatable" if many_presets else ""),
     )
     group.add_argument(
@@ -113,9 +108,13 @@ def add_body_options(
             metavar=metavar(declared),
             help=declared.help(),
         )
-    sphere = presets.DEFAULT_SPHERE
-    for declared, value in ((RADIUS, sphere.radius), (MASS, sphere.mass)):
-        help_text = f"{declared.help()} (default {declared.format(value)})"
+    try:
+        sphere: Sphere | None = registry.sphere
+    except UnknownNameError:  # no package declares one: the sphere must be given
+        sphere = None
+    for declared, value in ((RADIUS, "radius"), (MASS, "mass")):
+        default = "none" if sphere is None else declared.format(getattr(sphere, value))
+        help_text = f"{declared.help()} (default {default})"
         group.add_argument(declared.flag or "", metavar=metavar(declared), help=help_text)
 
 
@@ -159,7 +158,7 @@ class ModelChoice:
         self.registry = registry
         typed_names = {kind: getattr(args, kind, None) for kind in KINDS}
         self.names = {
-            kind: DEFAULT_NAMES[kind] if name is None else name
+            kind: registry.default(kind) if name is None else name
             for kind, name in typed_names.items()
         }
         self.settings: dict[str, dict[str, Any]] = {kind: {} for kind in KINDS}
@@ -229,15 +228,18 @@ def model_choice(args: argparse.Namespace, registry: PluginRegistry) -> ModelCho
     return ModelChoice(args, registry)
 
 
-def sphere_of(args: argparse.Namespace) -> Sphere:
+def sphere_of(args: argparse.Namespace, registry: PluginRegistry) -> Sphere:
     """The default sphere, or the one of --radius [mm] and --mass [g]."""
-    sphere = presets.DEFAULT_SPHERE
+    if args.radius is not None and args.mass is not None:
+        radius = _parse(RADIUS, args.radius, "--radius", args)
+        return Sphere(radius=radius, mass=_parse(MASS, args.mass, "--mass", args))
+    sphere = registry.sphere
     if args.radius is None and args.mass is None:
         return sphere
     radius = sphere.radius if args.radius is None else _parse(RADIUS, args.radius, "--radius", args)
     if args.mass is not None:
         return Sphere(radius=radius, mass=_parse(MASS, args.mass, "--mass", args))
-    return Sphere.of_density(radius, presets.SAE_52100_DENSITY)  # a new radius keeps the density
+    return Sphere.of_density(radius, registry.sphere_density)  # a new radius keeps the density
 
 
 def bodies(
@@ -265,7 +267,7 @@ def bodies(
             raise UsageError(f"--plate-file cannot be combined with {', '.join(given)}")
         base, label = load_plate_file(args.plate_file, choice.registry), args.plate_file
     elif args.preset is not None:
-        base, label = presets.plate(args.preset), args.preset
+        base, label = choice.registry.plate(args.preset), args.preset
     else:
         required = [THICKNESS, *(p for p in needed.values() if not p.has_default)]
         missing = [p.flag or f"--set plate.{p.name}" for p in required if p.name not in overrides]
@@ -275,14 +277,14 @@ def bodies(
                 f"(missing {', '.join(missing)})"
             )
         thickness = overrides.pop("thickness")
-        return sphere_of(args), Plate("custom", thickness, overrides), "custom"
+        return sphere_of(args, choice.registry), Plate("custom", thickness, overrides), "custom"
     if "thickness" in overrides:
         _check_new_thickness(base, label, overrides, flags, needed)
         base = attrs.evolve(base, thickness=overrides.pop("thickness"))
     if flags:
         base = Plate(base.material, base.thickness, {**base.constant_values(), **overrides})
         label = f"{label}+custom"
-    return sphere_of(args), base, label
+    return sphere_of(args, choice.registry), base, label
 
 
 def _check_new_thickness(

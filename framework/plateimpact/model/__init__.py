@@ -1,4 +1,4 @@
-"""The model: sphere, plate and scenes (one or a batch), the report's presets, the contact
+"""The model: sphere, plate and scenes (one or a batch), the contact
 geometry, the plug-in contracts of the physics (resistance law, failure model, their shared
 base), the impact model and its events, results and crater sections. It imports only
 plateimpact.base."""

@@ -32,6 +32,7 @@ from ..model.plugin import Plugin
 from ..model.resistance import ResistanceLaw
 from ..solve.integrator import Integrator
 from . import hookspecs
+from .choices import Choices
 from .discovery import (
     BrokenPackage,
     PluginOrigin,
@@ -69,8 +70,9 @@ def _flag_list(kind: str, cls: type[Plugin]) -> list[tuple[str, str]]:
     return [(flag, meaning) for flag, meaning in found if flag]
 
 
-class PluginRegistry:
-    """Name → class tables, one per kind of plug-in, and the plate constants they declare.
+class PluginRegistry(Choices):
+    """Name → class tables, one per kind of plug-in, and the plate constants they declare;
+    the defaults, presets and sphere packages declare (:class:`~.choices.Choices`).
 
     Registering checks a class's declarations: a plate constant may be declared by several
     plug-ins only with equal declarations, so that a plate's ``a`` means one thing
@@ -80,6 +82,7 @@ class PluginRegistry:
     """
 
     def __init__(self) -> None:
+        super().__init__()
         self._classes: dict[str, dict[str, type[Plugin]]] = {kind: {} for kind in KINDS}
         self._origin: dict[tuple[str, str], str] = {}
         self._constants: dict[str, tuple[Parameter, list[str]]] = {}
@@ -91,8 +94,10 @@ class PluginRegistry:
         """The installed plug-in packages that failed to load and were skipped."""
         return self._broken
 
-    def add(self, cls: type) -> None:
-        """Register a concrete ResistanceLaw, FailureModel or Integrator subclass."""
+    def add(self, cls: type, *, default: bool = False) -> None:
+        """Register a concrete ResistanceLaw, FailureModel or Integrator subclass; with
+        ``default``, as the plug-in of its kind used when none is named (PluginError if
+        another package claimed that default)."""
         kinds = [k for k, base in KINDS.items() if isinstance(cls, type) and issubclass(cls, base)]
         if len(kinds) != 1:
             raise PluginError(f"{cls!r} is not a ResistanceLaw, FailureModel or Integrator")
@@ -110,6 +115,8 @@ class PluginRegistry:
                 f"and by {cls.__module__}"
             )
         self._check_declarations(kind, plugin, label)
+        if default:
+            self._claim_default(kind, name, plugin.__module__)
         for declared in plugin.plate_constants:
             entry = self._constants.setdefault(declared.name, (declared, []))
             entry[1].append(f"{kind} {name}")
@@ -126,12 +133,14 @@ class PluginRegistry:
             {kind: dict(table) for kind, table in self._classes.items()},
             dict(self._origin),
             {name: (declared, list(users)) for name, (declared, users) in self._constants.items()},
+            self._save_choices(),
         )
         self._attempted = attempted
         try:
             yield
         except BaseException:
-            self._classes, self._origin, self._constants = saved
+            self._classes, self._origin, self._constants = saved[:3]
+            self._restore_choices(saved[3])
             raise
         finally:
             self._attempted = None

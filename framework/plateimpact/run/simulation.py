@@ -21,10 +21,6 @@ from ..solve.driver import integrate
 from ..solve.integrator import Integrator
 from .progress import report_scenes
 
-#: The plug-ins a model uses unless told otherwise (the report's model).
-DEFAULT_RESISTANCE = "poncelet"
-DEFAULT_FAILURE = "plugging"
-DEFAULT_INTEGRATOR = "dopri5"
 #: Scenes per task when a batch is spread over an executor or a study runs in chunks:
 #: large enough that the step loop's per-iteration overhead (about 1 ms) is spread over
 #: many scenes, small enough to balance work and to move a progress bar.
@@ -64,9 +60,9 @@ class Simulation:
     @classmethod
     def from_names(
         cls,
-        resistance: str = DEFAULT_RESISTANCE,
-        failure: str = DEFAULT_FAILURE,
-        integrator: str = DEFAULT_INTEGRATOR,
+        resistance: str | None = None,
+        failure: str | None = None,
+        integrator: str | None = None,
         *,
         resistance_settings: Mapping[str, Any] | None = None,
         failure_settings: Mapping[str, Any] | None = None,
@@ -74,10 +70,14 @@ class Simulation:
         rest_speed_fraction: float = REST_SPEED_FRACTION.default,  # type: ignore[assignment]
         registry: PluginRegistry | None = None,
     ) -> Simulation:
-        """Resolve each slot by name from ``registry`` (default: installed plug-ins)."""
+        """Resolve each slot by name from ``registry`` (default: installed plug-ins); a
+        slot not named takes the registry's default plug-in of its kind."""
         registry = default_registry() if registry is None else registry
         if not isinstance(registry, PluginRegistry):
             raise ParameterError("registry", f"registry must be a PluginRegistry, got {registry!r}")
+        resistance = registry.default("resistance") if resistance is None else resistance
+        failure = registry.default("failure") if failure is None else failure
+        integrator = registry.default("integrator") if integrator is None else integrator
         for slot, given in [
             ("resistance_settings", resistance_settings),
             ("failure_settings", failure_settings),

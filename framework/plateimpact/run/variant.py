@@ -10,34 +10,62 @@ import attrs
 import numpy as np
 
 from ..base.errors import ParameterError
+from ..base.parameters import Parameter
 from ..base.untrusted import load_json
 from ..model.impact import REST_SPEED_FRACTION
-from ..registry.plugin_registry import PluginRegistry
-from .simulation import DEFAULT_FAILURE, DEFAULT_INTEGRATOR, DEFAULT_RESISTANCE, Simulation
+from ..registry.plugin_registry import KINDS, PluginRegistry, default_registry
+from .simulation import Simulation
+
+
+class _NotJson(Exception):
+    """A setting value with no JSON form of its own (a plug-in's table, ...)."""
 
 
 def _json_value(value: object) -> object:
-    """Settings as JSON values, so that a variant is archived and read back unchanged."""
+    """numpy values as JSON values; anything else is for its declaration to convert."""
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, np.ndarray):
         return value.tolist()
-    if hasattr(value, "as_setting"):  # e.g. a PstarTable: its rows
-        return value.as_setting()
-    raise ParameterError("settings", f"setting value {value!r} is not a JSON value")
+    raise _NotJson
+
+
+def _as_json(settings: Mapping[str, Any]) -> dict[str, Any] | None:
+    """``settings`` as JSON values, or None if one has no JSON form of its own."""
+    try:
+        found: dict[str, Any] = json.loads(
+            json.dumps(dict(settings), default=_json_value, sort_keys=True)
+        )
+    except _NotJson:
+        return None
+    return found
 
 
 def _settings(value: Mapping[str, Any] | None) -> dict[str, Any]:
+    """A settings mapping checked; its values as JSON where they are plain values (the
+    others are converted by their declarations once the plug-in is known)."""
     if value is not None and not isinstance(value, Mapping):
         raise ParameterError(
             "settings", f"settings must be a mapping of names to values, got {value!r:.80}"
         )
     if not all(isinstance(name, str) for name in value or {}):
         raise ParameterError("settings", f"setting names must be strings, got {list(value or {})}")
-    settings: dict[str, Any] = json.loads(
-        json.dumps(dict(value or {}), default=_json_value, sort_keys=True)
-    )
-    return settings
+    return _as_json(value or {}) or dict(value or {})
+
+
+def _declared_json(declared: Mapping[str, Parameter], settings: dict[str, Any]) -> dict[str, Any]:
+    """Settings whose values are not all JSON, converted by the plug-in's declarations
+    ``declared`` (``Parameter.to_json``: a table setting gives its rows), so that a variant
+    holds what the archive stores."""
+    converted = {
+        name: declared[name].json_value(value) if name in declared else value
+        for name, value in settings.items()
+    }
+    found = _as_json(converted)
+    if found is None:
+        bad = next(v for v in converted.values() if _as_json({"v": v}) is None)
+        raise ParameterError("settings", f"setting value {bad!r:.80} is not a JSON value")
+    return found
 
 
 def check_name(instance: object, attribute: attrs.Attribute, value: object) -> None:
@@ -64,18 +92,35 @@ def check_plugin_name(instance: object, attribute: attrs.Attribute, value: objec
 class Variant:
     """One model variant of a study: plug-in names and their settings [SI].
 
-    Settings are held as JSON values (a :class:`PstarTable` becomes its rows), exactly as
-    the archive stores them, so a variant read back from an archive equals this one.
+    Settings are held as JSON values, exactly as the archive stores them, so a variant
+    read back from an archive equals this one: a value with no JSON form of its own (a
+    plug-in's table) is converted by the setting's declaration (``Parameter.to_json``).
+    A plug-in not named is the installed packages' default of its kind (the registry's
+    ``default``); the plug-ins are looked up there, too, to convert such a value.
     """
 
     name: str = attrs.field(validator=check_name)
-    resistance: str = attrs.field(default=DEFAULT_RESISTANCE, validator=check_plugin_name)
-    failure: str = attrs.field(default=DEFAULT_FAILURE, validator=check_plugin_name)
-    integrator: str = attrs.field(default=DEFAULT_INTEGRATOR, validator=check_plugin_name)
+    resistance: str = attrs.field(
+        factory=lambda: default_registry().default("resistance"), validator=check_plugin_name
+    )
+    failure: str = attrs.field(
+        factory=lambda: default_registry().default("failure"), validator=check_plugin_name
+    )
+    integrator: str = attrs.field(
+        factory=lambda: default_registry().default("integrator"), validator=check_plugin_name
+    )
     resistance_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     failure_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     integrator_settings: dict[str, Any] = attrs.field(factory=dict, converter=_settings)
     rest_speed_fraction: float = REST_SPEED_FRACTION.field()
+
+    def __attrs_post_init__(self) -> None:
+        for kind in KINDS:
+            settings = getattr(self, f"{kind}_settings")
+            if _as_json(settings) is None:  # the installed plug-in's declarations convert it
+                cls = default_registry().get(kind, getattr(self, kind))
+                converted = _declared_json(cls.setting_declarations(), settings)
+                object.__setattr__(self, f"{kind}_settings", converted)
 
     def simulation(self, registry: PluginRegistry | None = None) -> Simulation:
         """The resolved model and integrator (plug-ins looked up by name once)."""

@@ -14,7 +14,6 @@ import numpy as np
 
 from ..base.errors import ArchiveWaitWarning, ParameterError, UnknownNameError
 from ..comparison.ranges import Comparison
-from ..model import presets
 from ..model.batch import SceneBatch, check_chunk_size
 from ..model.bodies import Plate, Sphere
 from ..model.results import BatchResult
@@ -112,12 +111,16 @@ class Study:
         speeds: Sequence[float],
         variants: Iterable[Variant] | Variant,
         *,
-        sphere: Sphere = presets.DEFAULT_SPHERE,
+        sphere: Sphere | None = None,
         description: str = "",
+        registry: PluginRegistry | None = None,
     ) -> Study:
         """Every plate × obliquity × speed: ``obliquities_deg`` [deg] (the name says so:
         :meth:`SceneBatch.grid` takes radians), ``speeds`` [m/s]; plates by preset name
-        or Plate."""
+        or Plate, presets and the default ``sphere`` from ``registry`` (default: the
+        installed plug-in packages')."""
+        registry = registry or default_registry()
+        sphere = registry.sphere if sphere is None else sphere
         batches, labels = [], []
         plates = _tuple("plates", plates)  # type: ignore[assignment]
         if not plates:
@@ -128,7 +131,7 @@ class Study:
                     "plates", f"plates must be preset names or Plate objects, got {plate!r}"
                 )
             label = plate if isinstance(plate, str) else _plate_label(plate)
-            plate = presets.plate(plate) if isinstance(plate, str) else plate
+            plate = registry.plate(plate) if isinstance(plate, str) else plate
             batch = SceneBatch.grid(sphere, plate, speeds, np.radians(obliquities_deg))
             batches.append(batch)
             labels += [label] * batch.size

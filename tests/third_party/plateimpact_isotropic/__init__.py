@@ -25,7 +25,7 @@ import attrs
 import numpy as np
 
 from plateimpact import Parameter, PluginRegistry, Range, ResistanceLaw, SceneBatch, hookimpl
-from plateimpact_plugins import DENSITY_B, STRENGTH_A
+from plateimpact_plugins.report import DENSITY_B, STRENGTH_A
 
 from .brittle import Brittle
 from .rk4 import ClassicalRungeKutta

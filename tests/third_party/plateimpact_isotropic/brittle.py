@@ -6,7 +6,7 @@ import attrs
 import numpy as np
 
 from plateimpact import Contact, FailureModel, Parameter, Range, SceneBatch
-from plateimpact_plugins import CRITICAL_PENETRATION
+from plateimpact_plugins.report import CRITICAL_PENETRATION
 
 RESIDUAL_RESISTANCE = Parameter(
     "residual_resistance",

@@ -7,13 +7,12 @@ import argparse
 import json
 import math
 import os
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
 from ...base.units import g, mm
-from ...calibration import Calibration, CalibrationReport, calibrate, model_residual_speeds
-from ...calibration.pstar_plan import MAX_FIT_SCENES
+from ...calibration import MAX_FIT_SCENES, model_residual_speeds
 from ...model.bodies import Plate, Sphere
 from ...provenance.metadata import versions
 from ...registry.plugin_registry import PluginRegistry
@@ -30,6 +29,9 @@ from ..writer import Writer
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+#: The registered calibration procedure's results (a plug-in package's classes).
+Calibration: TypeAlias = Any
+CalibrationReport: TypeAlias = Any
 #: Model-curve points on the figure.
 CURVE_POINTS = 150
 
@@ -101,7 +103,8 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     sphere, given, _ = bodies(args, choice, simulation.model)
     plate = Plate(args.material, given.thickness, given.constants)
     with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
-        report = calibrate(
+        # the registered calibration procedure: the report's, from its plug-in package
+        report = choice.registry.procedure("calibration").calibrate(
             shots, plate, sphere=sphere, simulation=simulation,
             max_scenes=None if args.force else MAX_FIT_SCENES,
         )  # fmt: skip
@@ -238,7 +241,7 @@ def _figure(report: CalibrationReport, sphere: Sphere, simulation: Simulation) -
     )
     fits = (report.newton, report.direct)
     curves = model_residual_speeds(
-        simulation, sphere, fits[0].plate, speeds, [(f.a, f.b) for f in fits]
+        simulation, sphere, fits[0].plate, speeds, [{"a": f.a, "b": f.b} for f in fits]
     )
     fig, ax = figure(figsize=(7, 5))
     plot_calibration(

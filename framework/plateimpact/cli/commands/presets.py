@@ -8,7 +8,6 @@ import json
 from typing import Any
 
 from ...base.parameters import Parameter
-from ...model import presets
 from ...model.bodies import MASS, RADIUS, THICKNESS
 from ...registry.plugin_registry import PluginRegistry
 from ..formatting import quantity
@@ -29,17 +28,17 @@ def _user_value(declared: Parameter, value: float) -> float:
 def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     declared = {THICKNESS.name: THICKNESS, **registry.plate_constants}
     rows: dict[str, dict[str, Any]] = {}
-    for name, plate in presets.PLATES.items():
+    for name, plate in registry.plates.items():
         row: dict[str, Any] = {"material": plate.material}
         for constant, value in [("thickness", plate.thickness), *plate.constants]:
             row[declared[constant].key] = _user_value(declared[constant], value)
         rows[name] = row
-    sphere = presets.DEFAULT_SPHERE
+    sphere = registry.sphere
     sphere_row = {
-        "material": "SAE 52100",
+        "material": registry.sphere_material,
         RADIUS.key: _user_value(RADIUS, sphere.radius),
         MASS.key: _user_value(MASS, sphere.mass),
-        "density_kg_m3": presets.SAE_52100_DENSITY,
+        "density_kg_m3": registry.sphere_density,
     }
     if args.json:
         out.say(json.dumps({"plates": rows, "sphere": sphere_row}, indent=2))
@@ -50,8 +49,9 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         values = " ".join(f"{row[k]:12.4g}" for k in keys)
         out.say(f"{name:14s} {row['material']:9s} {values}")
     out.say(
-        f"\nsphere (default): SAE 52100, radius {quantity(RADIUS, sphere.radius, 4)}, "
+        f"\nsphere (default): {registry.sphere_material}, "
+        f"radius {quantity(RADIUS, sphere.radius, 4)}, "
         f"mass {quantity(MASS, sphere.mass, 4, 'f')}, density "
-        f"{quantity(DENSITY, presets.SAE_52100_DENSITY, 0, 'f')}"
+        f"{quantity(DENSITY, registry.sphere_density, 0, 'f')}"
     )
     return 0

@@ -26,10 +26,16 @@ import attrs
 import numpy as np
 from scipy.optimize import elementwise, minimize
 
-from ..base.errors import ConvergenceError
-from ..limits.bracketing import GROUP_SCENES, scan_intervals
-from .model_lines import Cost, LineModel
-from .outcome_model import Bands, ProbabilityModel, ShotLines, log_likelihood
+from plateimpact import ConvergenceError, calibration
+
+Bands = calibration.Bands
+Cost = calibration.Cost
+LineModel = calibration.LineModel
+ProbabilityModel = calibration.ProbabilityModel
+ShotLines = calibration.ShotLines
+log_likelihood = calibration.log_likelihood
+scan_scenes = calibration.scan_scenes
+GROUP_SCENES = calibration.GROUP_SCENES
 
 #: The search range of P*, in sphere radii, and the number of candidates its scan runs.
 PSTAR_RANGE = (0.1, 4.0)
@@ -61,11 +67,6 @@ NEAR = 3.0
 #: The failure constants a fit sets.
 PSTAR, ALPHA = "critical_penetration", "failure_angle"
 _NONE = np.zeros(0)
-
-
-def scan_scenes(shots: ShotLines, resolution: float) -> int:
-    """The scan samples of the lines of one shot set, for one candidate."""
-    return int((scan_intervals(shots.start, shots.end, resolution) + 1).sum())
 
 
 @attrs.frozen

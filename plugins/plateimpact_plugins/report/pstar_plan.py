@@ -20,15 +20,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..base.errors import WorkBoundError
-from ..model.results import Outcome
-from .outcome_model import ShotLines
-from .pstar_search import ALPHA_FIT_EVALUATIONS, SCAN_POINTS, scan_scenes
+from plateimpact import Outcome, WorkBoundError, calibration
 
-#: The scenes a P* fit runs without being asked to run more (as a sweep, the limits and
-#: validate): about a minute and a half of scenes in one batch, several minutes in the
-#: fit's many small batches (docs/calibration.md).
-MAX_FIT_SCENES = 1_000_000
+from .pstar_search import ALPHA_FIT_EVALUATIONS, SCAN_POINTS, ShotLines, scan_scenes
+
+#: The scenes a fit runs without being asked to run more: the core's bound.
+MAX_FIT_SCENES = calibration.MAX_FIT_SCENES
 #: Candidates a set costs after its scan: the bracketing search (Chandrupatla, from a
 #: bracket of two scan steps to 0.1 % of P*: 5 to 7 measured) and the information's two
 #: points, with room.

@@ -1,4 +1,4 @@
-"""The plates of the report's Table 1 and its sphere.
+"""The plates of the report's Table 1 and its sphere, registered as presets.
 
 Names are ``MATERIAL/THICKNESS_MM``. The 6061-T6 plate is listed as 9.52 mm in Table 1
 and 9.53 mm in the figures; its preset is named by the figures and keeps Table 1's
@@ -9,9 +9,9 @@ thickness. Table 1 prints it under 2024-T3, but Figures 11–17 and 35 name it 6
 
 from __future__ import annotations
 
-from ..base.errors import UnknownNameError
-from ..base.units import deg, mm
-from .bodies import Plate, Sphere
+from plateimpact import Plate, PluginRegistry, Sphere, units
+
+deg, mm = units.deg, units.mm
 
 #: Density of the SAE 52100 sphere [kg/m³] (not in the report; a handbook value).
 SAE_52100_DENSITY = 7830.0
@@ -40,11 +40,8 @@ PLATES: dict[str, Plate] = {
 }
 
 
-def plate(name: str) -> Plate:
-    """The preset plate ``name``; UnknownNameError lists the choices."""
-    try:
-        return PLATES[name]
-    except KeyError:
-        raise UnknownNameError(
-            f"unknown preset {name!r}; choose from: {', '.join(PLATES)}"
-        ) from None
+def register_presets(registry: PluginRegistry) -> None:
+    """Table 1's plates as presets, and the report's sphere as the default sphere."""
+    for name, plate in PLATES.items():
+        registry.add_plate(name, plate)
+    registry.set_sphere(DEFAULT_SPHERE, density=SAE_52100_DENSITY, material="SAE 52100")

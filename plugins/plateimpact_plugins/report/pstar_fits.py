@@ -13,16 +13,38 @@ import math
 import attrs
 import numpy as np
 
-from ..base.errors import CalibrationError, ConvergenceError
-from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
-from ..model.bodies import Plate, Sphere
-from ..model.presets import DEFAULT_SPHERE
-from ..run.simulation import Simulation
-from ..storage.shots import Shots
-from .model_lines import Cost, LineModel, check_finder
-from .outcome_model import ProbabilityModel, ShotLines, allowed_outcomes, shot_lines
+from plateimpact import (
+    CalibrationError,
+    ConvergenceError,
+    Plate,
+    Shots,
+    Simulation,
+    Sphere,
+    calibration,
+    limits,
+)
+
+from .presets import DEFAULT_SPHERE
 from .pstar_plan import MAX_FIT_SCENES, check_work, unfittable
-from .pstar_search import ALPHA, PSTAR, PstarEstimate, Search, fit_sets, fit_with_alpha
+from .pstar_search import (
+    ALPHA,
+    PSTAR,
+    Cost,
+    LineModel,
+    ProbabilityModel,
+    PstarEstimate,
+    Search,
+    ShotLines,
+    fit_sets,
+    fit_with_alpha,
+)
+from .pstar_table import TABLE_COLUMNS
+
+SPEED_RESOLUTION = limits.SPEED_RESOLUTION
+SPEED_TOLERANCE = limits.SPEED_TOLERANCE
+allowed_outcomes = calibration.allowed_outcomes
+shot_lines = calibration.shot_lines
+check_finder = calibration.check_finder
 
 #: Fewest shots for a fit of P*, and for each range of the by-obliquity fit.
 MIN_SHOTS = 5
@@ -33,16 +55,8 @@ MIN_RANGE_SHOTS = 3
 MAX_OBLIQUITIES = 1_000
 #: Fewest residual speeds whose scatter σ_r can be fitted.
 MIN_RESIDUALS = 5
-#: The columns of the variable-pstar plug-in's table (plateimpact_plugins.variable_pstar;
-#: the core never imports plug-ins, a test checks they agree), then the standard errors,
-#: which its reader ignores.
-TABLE_COLUMNS = (
-    "obliquity_deg",
-    "ricochet_pstar_mm",
-    "perforation_pstar_mm",
-    "transition_start_m_s",
-    "transition_end_m_s",
-)
+#: After the table's own columns (TABLE_COLUMNS), the standard errors, which its reader
+#: ignores.
 STDERR_COLUMNS = ("ricochet_pstar_stderr_mm", "perforation_pstar_stderr_mm")
 
 

@@ -1,7 +1,8 @@
-"""The report's plate constants (Table 1), declared by the built-ins that use them.
+"""The report's plate constants (Table 1): a, b (eq 1), P* and α* (eq 8), declared once.
 
-A third-party plug-in that reads one of them declares the same object (importing it from
-here), so that every plug-in means the same thing by ``a`` or ``critical_penetration``.
+The built-ins that read them declare these objects; a third-party plug-in that reads one
+declares the same object (``from plateimpact_plugins.report import STRENGTH_A``), so that
+every plug-in means the same thing by ``a`` or ``critical_penetration``.
 """
 
 from __future__ import annotations

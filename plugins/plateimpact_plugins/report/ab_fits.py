@@ -9,22 +9,37 @@ import attrs
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..base.errors import CalibrationError, ConvergenceError, WorkBoundError
-from ..model.bodies import Plate, Sphere
-from ..model.presets import DEFAULT_SPHERE
-from ..run.simulation import Simulation
-from ..storage.shots import Shots
-from .dri import MIN_PERFORATIONS, DriFit, fit_dri
-from .pstar_plan import MAX_FIT_SCENES
-from .start import (
+from plateimpact import (
+    CalibrationError,
+    ConvergenceError,
+    DriFit,
+    Plate,
+    Shots,
+    Simulation,
+    Sphere,
+    WorkBoundError,
+    calibration,
+    fit_dri,
+)
+
+from .ab_start import (
     check_start,
     energy_balance_start,
-    fit_model_dri,
     in_model_domain,
     log_domain,
     model_residual_speeds,
-    normal_shots,
 )
+from .presets import DEFAULT_SPHERE
+from .pstar_plan import MAX_FIT_SCENES
+
+MIN_PERFORATIONS = calibration.MIN_PERFORATIONS
+fit_model_dri = calibration.fit_model_dri
+
+
+def normal_shots(shots: Shots) -> Shots:
+    """The normal-incidence shots the fits of a and b take (three perforations at least)."""
+    return calibration.normal_shots(shots, "a and b")
+
 
 #: Relative step of a and b for the finite differences of eqs 44–47 (and the direct fit).
 DIFFERENCE_STEP = 1e-3
