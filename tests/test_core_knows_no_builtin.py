@@ -4,9 +4,9 @@ plug-ins), which registers them; the core reads them from the registry (issue 22
 
 What is checked: every NAME token and every string literal of ``framework/`` that is not
 a docstring (f-string parts included, and each word of a literal), against the names
-below. Not checked: the one-letter constants ``a`` and ``b`` (the core's calibration of
-them is in NOT_YET). Comments and docstrings
-may cite the report (its equations, Table 1, the plug-ins as examples): they are prose,
+below. Not checked: the one-letter constants ``a`` and ``b`` (as words they are too
+common: the core's ``"a"``/``"b"`` are the two runs a comparison compares). Comments and
+docstrings may cite the report (its equations, Table 1, the plug-ins as examples): they are prose,
 not code. The names come from the plug-in package itself, so a built-in added there is
 checked too.
 """
@@ -26,15 +26,6 @@ from plateimpact_plugins.report import presets as report_presets
 
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "framework" / "plateimpact"
-
-#: Files of the core that still name the report's vocabulary, with why: the calibrate
-#: command's options and output (the procedure itself is the report room's, found through
-#: the registry) move to the room once commands can be plug-ins. Nothing may be added.
-NOT_YET: dict[str, str] = {
-    "cli/commands/calibrate.py": "the calibrate command (--fit ab)",
-    "cli/calibrate_pstar.py": "the calibrate command (--fit pstar)",
-}
-
 
 #: Words that are a built-in's name and also plain English where the core uses them.
 PLAIN_WORDS = {
@@ -101,8 +92,6 @@ def test_the_core_names_no_built_in_plug_in_constant_table_column_or_preset():
     found = []
     for path in sorted(CORE.rglob("*.py")):
         where = str(path.relative_to(CORE))
-        if where in NOT_YET:
-            continue
         found += [
             f"{where}:{line}: {word}"
             for line, word in code_words(path)
@@ -111,15 +100,18 @@ def test_the_core_names_no_built_in_plug_in_constant_table_column_or_preset():
     assert not found, "\n".join(found)
 
 
-def test_the_files_not_yet_moved_still_exist_and_still_need_their_exemption():
-    names = forbidden()
-    for where in NOT_YET:
-        path = CORE / where
-        assert path.is_file(), where
-        assert any(word in names for _, word in code_words(path)), f"{where}: drop its exemption"
-
-
 def test_a_docstring_is_prose_but_a_string_literal_is_code(tmp_path):
     path = tmp_path / "m.py"
     path.write_text('"""Uses plugging (eq 8)."""\n\nNAME = "plugging"\n# a comment: poncelet\n')
     assert [w for _, w in code_words(path) if w in forbidden()] == ["plugging", "plugging"]
+
+
+def test_calibrate_is_the_registered_procedures_and_without_one_is_one_line(capsys):
+    from plateimpact.cli import main
+
+    bare = pi.load_registry(entry_points=False)  # no plug-in package: no procedure
+    assert main(["calibrate", "shots.csv"], registry=bare) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no installed plug-in package provides the calibrate" in err
+    procedure = pi.default_registry().procedure("calibrate")
+    assert procedure.__name__ == "plateimpact_plugins.report.calibrate_command"

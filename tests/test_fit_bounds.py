@@ -148,7 +148,7 @@ COARSE = {"resolution": 8.0, "tolerance": 1.0}
 def test_the_command_line_names_force_and_force_lifts_the_bound(tmp_path, monkeypatch):
     """One line, 350-610 m/s at 8 m/s: 33 intervals, 34 samples, x 27 candidates."""
     path = csv_of(ONE_LINE, tmp_path)
-    monkeypatch.setattr("plateimpact.cli.calibrate_pstar.MAX_FIT_SCENES", 900)
+    monkeypatch.setattr("plateimpact_plugins.report.calibrate_pstar_command.MAX_FIT_SCENES", 900)
     argv = ["calibrate", path, "--fit", "pstar", "--preset", "2024-T3/3.18", "--rtol", "1e-6",
             "--resolution", "8", "--tolerance", "1"]  # fmt: skip
     code, _, err = run_cli(argv)

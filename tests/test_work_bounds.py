@@ -158,7 +158,7 @@ def test_the_ab_fit_is_bounded_before_any_scene_by_its_normal_shots(no_scene, mo
     plate = presets.plate("2024-T3/3.18")
     with pytest.raises(WorkBoundError, match=r"up to 3,195 scenes .* more than 3,194"):
         report.calibrate(shots, plate, max_scenes=3194)
-    monkeypatch.setattr("plateimpact.cli.commands.calibrate.MAX_FIT_SCENES", 3194)
+    monkeypatch.setattr("plateimpact_plugins.report.calibrate_command.MAX_FIT_SCENES", 3194)
     argv = ["calibrate", str(ROOT / NORMAL), "--thickness", "3.18", "--pstar", "3", "--alpha", "45"]
     code, _, err = run_cli(argv)
     assert_one_line(code, err, "a, b fit: up to 3,195 scenes", "--force")

@@ -127,6 +127,7 @@ _EXPORTS: dict[str, str] = {
 _SUBMODULES: dict[str, str] = {
     "batch": "model.batch",
     "calibration": "calibration",
+    "command_line": "cli.toolkit",
     "experiment": "experiment",
     "geometry": "model.geometry",
     "limits": "limits",
@@ -213,6 +214,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .base.parameters import Parameter, Range
     from .base.untrusted import check_input, load_json, printable
     from .calibration import DriFit, ProbabilityModel, fit_dri
+    from .cli import toolkit as command_line
     from .comparison import Comparison
     from .experiment import ValidationReport, validate
     from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots

@@ -58,6 +58,7 @@ def plateimpact_register(registry: PluginRegistry) -> None:
         registry.add(other)
     register_presets(registry)
     registry.add_procedure("calibration", _calibration)
+    registry.add_procedure("calibrate", _calibrate_command)
 
 
 def _calibration() -> ModuleType:
@@ -65,3 +66,11 @@ def _calibration() -> ModuleType:
     from .report import fits  # noqa: PLC0415
 
     return fits
+
+
+def _calibrate_command() -> ModuleType:
+    """The report's ``plateimpact calibrate``: its options and work (imported when the
+    command is invoked)."""
+    from .report import calibrate_command  # noqa: PLC0415
+
+    return calibrate_command

@@ -30,8 +30,8 @@ COMMANDS = (
     Command(
         "calibrate",
         "calibrate",
-        "fit a and b to residual speeds at normal incidence (DRI fit, eqs 40-49), or P* and "
-        "alpha* to oblique shots (--fit pstar)",
+        "fit a model's plate constants to measured shots, by the calibration procedure an "
+        "installed plug-in package provides (the built-ins': the report's)",
     ),
     Command(
         "validate",

@@ -9,28 +9,12 @@ import math
 import os
 from typing import Any, TypeAlias
 
-from ..base.units import g, mm
-from ..calibration import (
-    MAX_FIT_SCENES,
-    OUTCOME_BLUNDER,
-    RESIDUAL_SIGMA_BOUNDS,
-    SPEED_SIGMA,
-    Cost,
-    ProbabilityModel,
-    check_finder,
-)
-from ..limits import SPEED_RESOLUTION, SPEED_TOLERANCE
-from ..model.bodies import Plate, Sphere
-from ..provenance.metadata import versions
-from ..registry.plugin_registry import PluginRegistry
-from ..run.progress import reporting_scenes
-from ..run.simulation import Simulation
-from ..storage.plate_file import plate_file_text
-from ..storage.shots import Shots
-from .common import UsageError, check_directory, write_atomically
-from .formatting import ANGLE, user
-from .options import bodies, model_choice, typed
-from .writer import Writer
+from plateimpact import Plate, PluginRegistry, Shots, Simulation, Sphere, calibration, limits, units
+from plateimpact import command_line as cli
+
+g, mm = units.g, units.mm
+#: The largest fit run unasked [scenes] (the core's bound; a name here for tests to lower).
+MAX_FIT_SCENES = calibration.MAX_FIT_SCENES
 
 #: The fits, and their search's constants, are the registered calibration procedure's
 #: (``registry.procedure("calibration")``, a plug-in package's): PstarFit, PstarTableFit
@@ -69,7 +53,7 @@ def add_pstar_options(p: argparse.ArgumentParser) -> None:
         type=float,
         metavar="M_S",
         help=f"impact-speed scatter s of the outcome probability, (0, 1000] m/s "
-        f"(default {SPEED_SIGMA:g})",
+        f"(default {calibration.SPEED_SIGMA:g})",
     )
     group.add_argument(
         "--residual-sigma",
@@ -81,13 +65,13 @@ def add_pstar_options(p: argparse.ArgumentParser) -> None:
         "--resolution",
         type=float,
         metavar="M_S",
-        help=f"boundary finder: no band this wide missed (default {SPEED_RESOLUTION:g} m/s)",
+        help=f"boundary finder: no band this wide missed (default {limits.SPEED_RESOLUTION:g} m/s)",
     )
     group.add_argument(
         "--tolerance",
         type=float,
         metavar="M_S",
-        help=f"boundary finder: boundaries to this (default {SPEED_TOLERANCE:g} m/s)",
+        help=f"boundary finder: boundaries to this (default {limits.SPEED_TOLERANCE:g} m/s)",
     )
 
 
@@ -95,52 +79,53 @@ def refuse_pstar_options(args: argparse.Namespace) -> None:
     """With --fit ab, a typed --fit pstar option is an error, not ignored."""
     for flag, (dest, default) in PSTAR_OPTIONS.items():
         if getattr(args, dest) != default:
-            raise UsageError(f"{flag}: only with --fit pstar")
+            raise cli.UsageError(f"{flag}: only with --fit pstar")
 
 
-def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> None:
+def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: cli.Writer) -> None:
     """Run ``plateimpact calibrate --fit pstar``."""
     for flag in ("--method", "--png"):
         if getattr(args, flag.lstrip("-")) is not None:
-            raise UsageError(f"{flag}: only with --fit ab")
+            raise cli.UsageError(f"{flag}: only with --fit ab")
     if args.by_obliquity and args.alpha_fit:
-        raise UsageError(
+        raise cli.UsageError(
             "--alpha-fit: not with --by-obliquity (the variable-pstar table holds P* only; "
             "fit alpha* first without --by-obliquity)"
         )
-    check_directory(args.out, "--out")
+    cli.check_directory(args.out, "--out")
     shots = Shots.from_csv(args.shots)
-    choice = model_choice(args, registry)
+    choice = cli.model_choice(args, registry)
     fits = registry.procedure("calibration")  # the report's, from its plug-in package
     simulation = choice.simulation()
     if getattr(args, "pstar", None) is not None or "critical_penetration" in choice.plate:
         flag = choice.plate_flags.get("critical_penetration", "--pstar")
-        raise UsageError(
+        raise cli.UsageError(
             f"{flag}: not with --fit pstar (P* is what it fits, over a fixed range; see "
             "docs/calibration.md)"
         )
     if args.preset is None and args.plate_file is None:
         given = {n for n in ("a", "b") if getattr(args, n, None) is not None or n in choice.plate}
         if given != {"a", "b"}:
-            raise UsageError(
+            raise cli.UsageError(
                 "--fit pstar holds a and b fixed: give --preset, --plate-file, or --a and --b "
                 "(fit them first with --fit ab)"
             )
         choice.plate.setdefault("critical_penetration", mm)  # what the fit finds
-    sphere, given_plate, _ = bodies(args, choice, simulation.model)
+    sphere, given_plate, _ = cli.bodies(args, choice, simulation.model)
     plate = Plate(args.material, given_plate.thickness, given_plate.constants)
-    typed(args).update({"speed_sigma": "--speed-sigma", "residual_sigma": "--residual-sigma"})
-    model = ProbabilityModel(
-        SPEED_SIGMA if args.speed_sigma is None else args.speed_sigma, args.residual_sigma
+    cli.typed(args).update({"speed_sigma": "--speed-sigma", "residual_sigma": "--residual-sigma"})
+    model = calibration.ProbabilityModel(
+        calibration.SPEED_SIGMA if args.speed_sigma is None else args.speed_sigma,
+        args.residual_sigma,
     )
     finder = {
-        "resolution": SPEED_RESOLUTION if args.resolution is None else args.resolution,
-        "tolerance": SPEED_TOLERANCE if args.tolerance is None else args.tolerance,
+        "resolution": limits.SPEED_RESOLUTION if args.resolution is None else args.resolution,
+        "tolerance": limits.SPEED_TOLERANCE if args.tolerance is None else args.tolerance,
     }
-    typed(args).update({"tolerance": "--tolerance", "resolution": "--resolution"})
-    check_finder(**finder)
+    cli.typed(args).update({"tolerance": "--tolerance", "resolution": "--resolution"})
+    calibration.check_finder(**finder)
     bound = None if args.force else MAX_FIT_SCENES
-    with reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
+    with cli.reporting_scenes("calibrate"):  # a count of scenes on a terminal after 2 s
         if args.by_obliquity:
             table = fits.fit_pstar_by_obliquity(
                 shots, plate, sphere=sphere, simulation=simulation, model=model,
@@ -156,13 +141,15 @@ def pstar_command(args: argparse.Namespace, registry: PluginRegistry, out: Write
     if args.by_obliquity:
         summary = _table_summary(fits, args, table, simulation, finder, sphere)
         if args.out is not None:
-            write_atomically(args.out, table.csv_text(), "--out")
+            cli.write_atomically(args.out, table.csv_text(), "--out")
         out.say(json.dumps(summary) if args.json else _table_text(args, table))
         return
     summary = _fit_summary(fits, args, fit, simulation, finder, sphere)
     if args.out is not None:
         extra = {"calibration": _provenance(args, fit, sphere, summary)}
-        write_atomically(args.out, plate_file_text(fit.plate, extra, registry=registry), "--out")
+        cli.write_atomically(
+            args.out, cli.plate_file_text(fit.plate, extra, registry=registry), "--out"
+        )
     out.say(json.dumps(summary) if args.json else _fit_text(fits, args, fit))
 
 
@@ -171,7 +158,7 @@ def _finite(x: float) -> float | None:
 
 
 def _probability_model(
-    args: argparse.Namespace, model: ProbabilityModel, sigma: float
+    args: argparse.Namespace, model: calibration.ProbabilityModel, sigma: float
 ) -> dict[str, Any]:
     return {
         "description": "P(outcome | v) = normal mass of the model's outcome bands about the "
@@ -182,12 +169,12 @@ def _probability_model(
         "speed_sigma_given": args.speed_sigma is not None,
         "residual_sigma_m_s": _finite(sigma),
         "residual_sigma_fitted": model.residual_sigma is None,
-        "outcome_blunder": OUTCOME_BLUNDER,
+        "outcome_blunder": calibration.OUTCOME_BLUNDER,
     }
 
 
 def _search(
-    fits: Any, finder: dict[str, float], cost: Cost, sphere_radius: float
+    fits: Any, finder: dict[str, float], cost: calibration.Cost, sphere_radius: float
 ) -> dict[str, Any]:
     return {
         "pstar_range_mm": [r * sphere_radius / mm for r in fits.PSTAR_RANGE],
@@ -217,11 +204,11 @@ def _fit_summary(
         "residual_speed_shots": fit.residual_shots,
         "pstar_mm": e.pstar / mm,
         "pstar_mm_stderr": e.pstar_stderr / mm,
-        "alpha_deg": user(ANGLE, e.alpha),
+        "alpha_deg": cli.user(cli.ANGLE, e.alpha),
         "alpha_fitted": fit.alpha_fitted,
     }
     if fit.alpha_fitted:
-        out["alpha_deg_stderr"] = user(ANGLE, e.alpha_stderr)
+        out["alpha_deg_stderr"] = cli.user(cli.ANGLE, e.alpha_stderr)
         out["pstar_alpha_correlation"] = e.correlation
     return out | {
         "log_likelihood": e.log_likelihood,
@@ -246,7 +233,7 @@ def _provenance(
         **{key: summary[key] for key in keep if key in summary},
         "probability_model": summary["probability_model"],
         "sphere": {"radius_mm": sphere.radius / mm, "mass_g": sphere.mass / g},
-        "plateimpact_version": versions()["plateimpact"],
+        "plateimpact_version": cli.versions()["plateimpact"],
         "model": summary["model"],
     }
 
@@ -258,7 +245,7 @@ def _fit_text(fits: Any, args: argparse.Namespace, fit: PstarFit) -> str:
         sigma = "no residual speeds"
     elif model.residual_sigma is not None:
         sigma = f"sigma_r = {e.residual_sigma:.3g} m/s (given)"
-    elif e.residual_sigma <= 1.001 * RESIDUAL_SIGMA_BOUNDS[0]:
+    elif e.residual_sigma <= 1.001 * calibration.RESIDUAL_SIGMA_BOUNDS[0]:
         sigma = (
             f"sigma_r = {e.residual_sigma:.3g} m/s (fitted, its lower bound: the impact-speed "
             "scatter accounts for the residual scatter)"
@@ -266,16 +253,17 @@ def _fit_text(fits: Any, args: argparse.Namespace, fit: PstarFit) -> str:
     else:
         sigma = f"sigma_r = {e.residual_sigma:.3g} m/s (fitted)"
     alpha = (
-        f"alpha* = {user(ANGLE, e.alpha):.4g} ± {user(ANGLE, e.alpha_stderr):.2g} deg "
+        f"alpha* = {cli.user(cli.ANGLE, e.alpha):.4g} "
+        f"± {cli.user(cli.ANGLE, e.alpha_stderr):.2g} deg "
         f"(correlation with P* {e.correlation:+.2f})"
         if fit.alpha_fitted
-        else f"alpha* = {user(ANGLE, e.alpha):.4g} deg (given)"
+        else f"alpha* = {cli.user(cli.ANGLE, e.alpha):.4g} deg (given)"
     )
     lines = [
         f"shots: {args.shots}: {fit.shots} used, {fit.residual_shots} with a residual speed",
         f"probability model: impact-speed scatter s = {model.speed_sigma:g} m/s"
         + (" (given)" if args.speed_sigma is not None else " (default)")
-        + f", {sigma}, blunder {OUTCOME_BLUNDER:g}",
+        + f", {sigma}, blunder {calibration.OUTCOME_BLUNDER:g}",
         f"P* = {e.pstar / mm:.5g} ± {e.pstar_stderr / mm:.2g} mm, {alpha}",
         f"log-likelihood {e.log_likelihood:.6g}; {e.near} shots within {fits.NEAR:g} s of a "
         f"boundary; {fit.cost.evaluations} candidates in {fit.cost.batches} batches, "
@@ -309,7 +297,7 @@ def _table_summary(
 ) -> dict[str, Any]:
     rows = [
         {
-            "obliquity_deg": float(f"{user(ANGLE, row.obliquity):.12g}"),  # 60, not 59.99..
+            "obliquity_deg": float(f"{cli.user(cli.ANGLE, row.obliquity):.12g}"),  # 60, not 59.99..
             **_estimate_json("ricochet", row.ricochet, row.ricochet_shots),
             **_estimate_json("perforation", row.perforation, row.perforation_shots),
             "transition_start_m_s": row.transition_start,
@@ -322,7 +310,7 @@ def _table_summary(
         "fit": "pstar",
         "by_obliquity": True,
         "shots_file": args.shots,
-        "alpha_deg": user(ANGLE, table.alpha),
+        "alpha_deg": cli.user(cli.ANGLE, table.alpha),
         "rows": rows,
         "probability_model": _probability_model(args, table.model, math.nan)
         | {"residual_sigma_m_s": None},
@@ -339,14 +327,14 @@ def _table_text(args: argparse.Namespace, table: PstarTableFit) -> str:
         return f"{e.pstar / mm:.4g} ± {e.pstar_stderr / mm:.2g}"
 
     lines = [
-        f"P* by obliquity from {args.shots} (alpha* = {user(ANGLE, table.alpha):.4g} deg, "
+        f"P* by obliquity from {args.shots} (alpha* = {cli.user(cli.ANGLE, table.alpha):.4g} deg, "
         f"impact-speed scatter s = {table.model.speed_sigma:g} m/s)",
         f"{'obliquity':>9s}  {'ricochet P* [mm]':>22s}{'shots':>6s}  "
         f"{'perforation P* [mm]':>22s}{'shots':>6s}  band [m/s]",
     ]
     notes = []
     for row in table.rows:
-        degrees = f"{user(ANGLE, row.obliquity):.6g}"
+        degrees = f"{cli.user(cli.ANGLE, row.obliquity):.6g}"
         lines.append(
             f"{degrees:>9s}  {value(row.ricochet):>22s}{row.ricochet_shots:6d}  "
             f"{value(row.perforation):>22s}{row.perforation_shots:6d}  "
