@@ -17,10 +17,8 @@ from .events import (
     CONTACT_LOST,
     EVENTS,
     FAILURE_EVENTS,
-    FAILURE_ONSET,
     ONSET,
     PERFORATED,
-    PERFORATION,
     TURNED_BACK,
 )
 from .failure import Contact, FailureModel
@@ -74,6 +72,8 @@ class ImpactModel:
     resistance: ResistanceLaw = attrs.field(validator=_plugin_of(ResistanceLaw))
     failure: FailureModel = attrs.field(validator=_plugin_of(FailureModel))
     rest_speed_fraction: float = REST_SPEED_FRACTION.field()
+    #: The rows of the failure events the failure model declares (set from its ``events``).
+    _failure_rows: frozenset[int] = attrs.field(init=False, eq=False, repr=False)
 
     #: Obliquity is held here once reached (docs/model.md §4, "θ = π"): straight back out [rad].
     MAX_OBLIQUITY: ClassVar[float] = np.pi
@@ -90,6 +90,8 @@ class ImpactModel:
                 f"failure {self.failure.name!r} declares event {foreign[0]!r}; a failure "
                 f"model adds only {', '.join(e.name for e in FAILURE_EVENTS)}"
             )
+        rows = frozenset(EVENTS.index(e) for e in self.failure.events)
+        object.__setattr__(self, "_failure_rows", rows)
 
     def plugins(self) -> Iterator[tuple[str, Plugin]]:
         """(slot, plug-in) for each slot that sees the batch."""
@@ -128,7 +130,7 @@ class ImpactModel:
             return Contact(
                 penetration, obliquity, speed, failure_state, batch.failure, law, obliquity_rate
             )
-        law = BoundResistance(self.resistance, batch.resistance.take(index))
+        law = BoundResistance(self.resistance, batch.resistance, index)
         return Contact(
             penetration[index],
             obliquity[index],
@@ -254,12 +256,14 @@ class ImpactModel:
         pen, obl = y[PENETRATION], np.abs(y[OBLIQUITY])  # θ < 0: the mirror image
         core = batch.core
         wanted = range(len(EVENTS)) if kinds is None else kinds
-        margins = np.full((len(EVENTS), pen.size), np.nan)
-        added = self.failure.events
+        shape = (len(EVENTS), pen.size)
+        # Every row is written when all are wanted; NaN marks the rows not computed.
+        margins = np.empty(shape) if kinds is None else np.full(shape, np.nan)
+        added = self._failure_rows
         if ONSET in wanted:
             margins[ONSET] = (
                 np.where(failed, -np.inf, pen - core.onset_penetration)
-                if FAILURE_ONSET in added
+                if ONSET in added
                 else -np.inf
             )
         if CONTACT_LOST in wanted:
@@ -267,7 +271,7 @@ class ImpactModel:
         if PERFORATED in wanted:
             margins[PERFORATED] = (
                 self._inward_perforation_margin(y, obl, failed, batch)
-                if PERFORATION in added
+                if PERFORATED in added
                 else -np.inf
             )
         if AT_REST in wanted:
@@ -295,9 +299,11 @@ class ImpactModel:
         rows = branch_margins(pen, obl, batch.core.radius)
         if not failed.any():
             return rows
-        index = np.flatnonzero(failed)
+        index = None if failed.all() else np.flatnonzero(failed)
         contact = self._contact(index, pen, obl, y[SPEED], y[KINEMATIC_STATE:], batch)
         failure_rows = self.failure.branch_margins(contact)
+        if index is None:
+            return np.concatenate([rows, failure_rows])
         extra = np.full((failure_rows.shape[0], pen.size), np.nan)
         extra[:, index] = failure_rows
         return np.concatenate([rows, extra])
@@ -307,12 +313,16 @@ class ImpactModel:
     ) -> np.ndarray:
         """>= 0 where perforation is complete [m]; −inf where the plate is intact.
         ``obliquity`` θ >= 0 [rad] (the mirror image of y's)."""
+        if not failed.any():
+            return np.full(obliquity.shape, -np.inf)
+        index = None if failed.all() else np.flatnonzero(failed)
+        pen, speed, state = y[PENETRATION], y[SPEED], y[KINEMATIC_STATE:]
+        contact = self._contact(index, pen, obliquity, speed, state, batch)
+        found = self.failure.perforation_margin(contact)
+        if index is None:
+            return np.asarray(found, dtype=float)
         margin = np.full(obliquity.shape, -np.inf)
-        if failed.any():
-            index = np.flatnonzero(failed)
-            pen, speed, state = y[PENETRATION], y[SPEED], y[KINEMATIC_STATE:]
-            contact = self._contact(index, pen, obliquity, speed, state, batch)
-            margin[index] = self.failure.perforation_margin(contact)
+        margin[index] = found
         return margin
 
     def _inward_perforation_margin(

@@ -63,13 +63,28 @@ def contact_force(
 class BoundResistance:
     """The model's resistance law on its own view of a set of scenes: what a failure
     model is given to compute forces on parts of the contact surface (the relieved force
-    F′ beyond a failure plane, a hinged finger) without seeing the law's columns."""
+    F′ beyond a failure plane, a hinged finger) without seeing the law's columns.
 
-    __slots__ = ("batch", "law")
+    ``index``: the scenes of ``batch`` it is about (None: all); the subset of the law's
+    view is taken when the law is first used, so a failure method that never asks for a
+    force (a margin) costs no copy of the law's columns.
+    """
 
-    def __init__(self, law: ResistanceLaw, batch: SceneBatch) -> None:
+    __slots__ = ("_batch", "_index", "law")
+
+    def __init__(
+        self, law: ResistanceLaw, batch: SceneBatch, index: np.ndarray | None = None
+    ) -> None:
         self.law = law
-        self.batch = batch
+        self._batch = batch
+        self._index = index
+
+    @property
+    def batch(self) -> SceneBatch:
+        """The law's view of the scenes it is about."""
+        if self._index is not None:
+            self._batch, self._index = self._batch.take(self._index), None
+        return self._batch
 
     def stress(self, speed: np.ndarray, incidence: np.ndarray) -> np.ndarray:
         """σ [N/m²] at speed V [m/s] and incidence ψ [rad]."""

@@ -200,7 +200,10 @@ def _integrate(
             held[turned] = True
             y[OBLIQUITY, turned] = ImpactModel.MAX_OBLIQUITY
         dynamics = Dynamics(model, batch, failed, held, stats)
-        restart = events[np.isin(kinds, RESTARTING)]
+        restarting = np.zeros(kinds.size, bool)
+        for row in RESTARTING:  # the events after which the right-hand side is new
+            restarting |= kinds == row
+        restart = events[restarting]
         if restart.size:  # a new right-hand side from here: the stepper starts afresh
             state = integrator.restart(dynamics, t, y, state, restart)
 
