@@ -6,9 +6,14 @@ median error of exit speed relative to impact speed, max and median error of exi
 obliquity [deg] (embedments excluded), outcome mismatches, time per scene (minimum of
 several runs after a warm-up) and right-hand-side evaluations per scene.
 
+Then the accuracy of the default (dopri5, rtol 1e-8) on two 10,000-scene sweeps against
+dopri5 at rtol 1e-13: the throughput benchmark's scenes, and 2024-T3/3.18 at 50-70 deg,
+500-1000 m/s, where steps cross the surface P = Rs(1 - sin θ) that the prediction of
+branch crossings can miss (the target: 1e-6 of impact speed, 1e-4 deg).
+
 Writes benchmarks/results/work_precision.csv and .png.
 
-Run:  python benchmarks/work_precision.py [--scenes 500]
+Run:  python benchmarks/work_precision.py [--scenes 500] [--sweeps-only]
 """
 
 from __future__ import annotations
@@ -65,7 +70,13 @@ def main() -> None:
     parser.add_argument(
         "--plot-only", action="store_true", help="redraw the figure from results/work_precision.csv"
     )
+    parser.add_argument(
+        "--sweeps-only", action="store_true", help="only the default's accuracy on the sweeps"
+    )
     args = parser.parse_args()
+    if args.sweeps_only:
+        sweep_accuracy()
+        return
     if args.plot_only:
         with open(RESULTS / "work_precision.csv", newline="") as handle:
             plot([tuple(row) for row in list(csv.reader(handle))[1:]], args.scenes)
@@ -143,6 +154,36 @@ def main() -> None:
 
     plot(rows, batch.size)
     print(f"wrote {RESULTS / 'work_precision.csv'} and work_precision.png")
+    sweep_accuracy()
+
+
+def sweep_accuracy() -> None:
+    """The default's largest errors on the two 10,000-scene sweeps (module docstring)."""
+    sphere, plate = pi.presets.DEFAULT_SPHERE, pi.presets.plate("2024-T3/3.18")
+    sweeps = {
+        "throughput benchmark's 10,000 scenes": benchmark_batch(10_000, seed=10_000),
+        "2024-T3/3.18, 50-70 deg, 500-1000 m/s": pi.SceneBatch.grid(
+            sphere, plate, np.linspace(500.0, 1000.0, 2000), np.radians([50, 55, 60, 65, 70])
+        ),
+    }
+    for label, batch in sweeps.items():
+        reference = pi.Simulation.from_names(
+            integrator_settings={"rtol": REFERENCE_RTOL}
+        ).run_batch(batch)
+        result = pi.Simulation.from_names().run_batch(batch)
+        flying = (reference.outcome != pi.Outcome.EMBEDMENT) & (
+            result.outcome != pi.Outcome.EMBEDMENT
+        )
+        speed_error = np.abs(result.exit_speed - reference.exit_speed) / batch.impact_speed
+        obliquity_error = np.degrees(np.abs(result.exit_obliquity - reference.exit_obliquity))
+        print(
+            f"default on {label}: outcome mismatches "
+            f"{int(np.sum(result.outcome != reference.outcome))}, max |Δ exit speed|/Vs "
+            f"{speed_error.max():.1e} (> 1e-6: {int(np.sum(speed_error > 1e-6))}), max |Δ exit "
+            f"obliquity| {obliquity_error[flying].max():.1e} deg (> 1e-4: "
+            f"{int(np.sum(obliquity_error[flying] > 1e-4))}), "
+            f"{result.stats['force_evaluations'] / batch.size:.1f} evaluations per scene"
+        )
 
 
 def plot(rows: list[tuple], scenes: int) -> None:

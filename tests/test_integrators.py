@@ -9,6 +9,8 @@ from scipy.optimize import brentq
 
 import plateimpact as pi
 from plateimpact import presets
+from plateimpact.solve import control as pi_control
+from plateimpact.solve import event_location as pi_event_location
 from plateimpact.units import deg
 
 SPHERE = presets.DEFAULT_SPHERE
@@ -231,3 +233,50 @@ def test_event_root_finding_ends_on_the_event_side_within_the_resolution(blur):
     sigma = locate(margin, dense, lo, hi, f_lo, f_hi)
     assert np.all(margin(dense(sigma)) >= 0.0)
     assert np.max(np.abs(path(sigma) - levels)) < 1e-10
+
+
+def unplanned_crossing_errors():
+    """Exit speed [Vs] and exit obliquity [deg] errors of the default dopri5 against rtol
+    1e-13 on 2024-T3/3.18 at 60 deg, 700-750 m/s: where steps cross P = Rs(1 - sin θ) that
+    the Euler prediction of approach_branches misses (issue 23)."""
+    batch = pi.SceneBatch.grid(
+        SPHERE, presets.plate("2024-T3/3.18"), np.linspace(700.0, 750.0, 201), np.radians([60.0])
+    )
+    reference = pi.Simulation.from_names(integrator_settings={"rtol": 1e-13}).run_batch(batch)
+    result = pi.Simulation.from_names().run_batch(batch)
+    assert np.array_equal(result.outcome, reference.outcome)
+    speed = np.abs(result.exit_speed - reference.exit_speed) / batch.impact_speed
+    flying = result.outcome != pi.Outcome.EMBEDMENT  # at rest, the direction is not exact
+    obliquity = np.degrees(np.abs(result.exit_obliquity - reference.exit_obliquity))[flying]
+    return speed.max(), obliquity.max()
+
+
+def test_a_step_that_crosses_a_branch_it_did_not_plan_for_is_redone_onto_it(monkeypatch):
+    speed, obliquity = unplanned_crossing_errors()
+    assert speed < 1e-6 and obliquity < 1e-4  # the default's accuracy target
+    # Accepting such steps (the check skipped) misses the target on the same scenes.
+    monkeypatch.setattr(
+        pi_control.StepSizes, "_refuse_unplanned_crossings", lambda self, ok, step, dyn: ok
+    )
+    speed, obliquity = unplanned_crossing_errors()
+    assert speed > 1e-6 or obliquity > 1e-4
+
+
+def onset_stepped_over():
+    """Scenes of 2024-T3/3.18 at 50 deg whose deepest penetration passes P* = 3 mm by a
+    hair (around 501 m/s) but whose plate did not fail: an onset margin that rose
+    through zero and fell back between two samples of a step, at the crest."""
+    plate = presets.plate("2024-T3/3.18")
+    batch = pi.SceneBatch.grid(SPHERE, plate, np.linspace(495.0, 510.0, 601), np.radians([50.0]))
+    result = pi.Simulation.from_names().run_batch(batch)
+    passed = result.max_penetration > plate.critical_penetration * (1 + 1e-12)
+    assert passed.any() and (~passed).any()  # the sweep straddles the grazing speed
+    return int(np.sum(passed & ~result.plate_failed))
+
+
+def test_failure_onset_is_never_stepped_over_at_the_crest(monkeypatch):
+    assert onset_stepped_over() == 0
+    # Without looking at the crest, the samples miss some of these onsets.
+    crest = pi_event_location._crest
+    monkeypatch.setattr(pi_event_location, "_crest", lambda *args: (*crest(*args)[:2], []))
+    assert onset_stepped_over() > 0

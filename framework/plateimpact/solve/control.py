@@ -31,10 +31,13 @@ class StepSizes:
 
     __slots__ = (
         "control",
+        "crossing",
+        "forced",
         "h",
         "just_rejected",
         "known_rates",
         "landing",
+        "margins",
         "planned",
         "scale",
         "unit",
@@ -51,22 +54,35 @@ class StepSizes:
         self.just_rejected = np.zeros(h.size, bool)
         self.planned: np.ndarray | None = None
         self.landing: np.ndarray | None = None
+        # The branch margins at the step's start (rows, n), the rows the step crosses on
+        # purpose, and the scenes whose next step must cross a surface found just ahead.
+        self.margins: np.ndarray | None = None
+        self.crossing: np.ndarray | None = None
+        self.forced = np.zeros(h.size, bool)
 
     def propose(self, dynamics: Dynamics, y: np.ndarray, state: StepperState) -> np.ndarray:
         """The steps to attempt now [s]."""
         if self.control is None:
             return self.h
         h = np.minimum(self.h, MAX_STEP * self.unit)
-        self.planned = self.landing = None
+        self.planned = self.landing = self.margins = self.crossing = None
         if self.control.branch_landing:
             known = self.known_rates(state)
             rates = dynamics.rates(y) if known is None else known
             self.planned = h
-            h, self.landing = approach_branches(dynamics, y, h, rates)
+            shortened, self.landing, self.margins, self.crossing = approach_branches(
+                dynamics, y, h, rates
+            )
+            # A surface found just ahead by a rejected step (judge) is crossed now, by the
+            # short step judge chose, whatever the prediction says.
+            h = np.where(self.forced, h, shortened)
+            self.landing &= ~self.forced
+            self.crossing |= self.forced
+            self.forced = np.zeros(h.size, bool)
         self.h = h
         return h
 
-    def judge(self, step: Step, y: np.ndarray) -> np.ndarray:
+    def judge(self, step: Step, y: np.ndarray, dynamics: Dynamics) -> np.ndarray:
         """Which steps are accepted; sets the next step sizes."""
         finite = np.all(np.isfinite(step.y), axis=0)
         if self.control is None or step.error is None:
@@ -90,19 +106,47 @@ class StepSizes:
             factor = np.where(self.landing & ok, self.planned / h, factor)
         self.just_rejected = ~ok
         self.h = h * factor
+        if self.margins is not None:
+            ok = self._refuse_unplanned_crossings(ok, step, dynamics)
         return ok
+
+    def _refuse_unplanned_crossings(
+        self, ok: np.ndarray, step: Step, dynamics: Dynamics
+    ) -> np.ndarray:
+        """Reject the steps that ended across a branch surface they did not plan to cross
+        (the prediction of approach_branches missed it), and redo each onto the surface:
+        to BRANCH_APPROACH of the way to it, located between the margins at the step's
+        two ends, or, where it lies within BRANCH_CROSSING of the start, across it with a
+        step of that fraction."""
+        assert self.margins is not None and self.crossing is not None
+        end = dynamics.branch_margins(step.y)
+        crossed = (self.margins * end < 0.0) & ~self.crossing
+        unplanned = crossed.any(axis=0) & ok
+        if not unplanned.any():
+            return ok
+        with np.errstate(invalid="ignore", divide="ignore"):
+            where = np.where(crossed, self.margins / (self.margins - end), np.inf).min(axis=0)
+        near = unplanned & (where < BRANCH_CROSSING)
+        short = unplanned & ~near
+        self.h = np.where(near, BRANCH_CROSSING * step.h, self.h)
+        self.h = np.where(short, BRANCH_APPROACH * where * step.h, self.h)
+        self.forced = near
+        self.just_rejected = self.just_rejected | unplanned
+        return ok & ~unplanned
 
     def take(self, keep: np.ndarray) -> None:
         """Keep the scenes ``keep`` (boolean mask)."""
         self.h, self.unit = self.h[keep], self.unit[keep]
         self.scale, self.just_rejected = self.scale[:, keep], self.just_rejected[keep]
+        self.forced = self.forced[keep]
 
 
 def approach_branches(
     dynamics: Dynamics, y: np.ndarray, h: np.ndarray, rates: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Steps shortened so as not to straddle a branch surface of the force, and the
-    scenes whose step now ends just short of one.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Steps shortened so as not to straddle a branch surface of the force, the scenes
+    whose step now ends just short of one, the branch margins at ``y`` (rows, n) and the
+    rows a step crosses on purpose (a surface within BRANCH_CROSSING of the step).
 
     Where the surface lies is predicted from the Euler step y + h f(y) (the sign change
     of :meth:`ImpactModel.branch_margins`, interpolated linearly): an O(h²) guess, which
@@ -112,10 +156,11 @@ def approach_branches(
     now = dynamics.branch_margins(y)
     ahead = dynamics.branch_margins(y + h * rates)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fraction = np.where(now * ahead < 0.0, now / (now - ahead), np.inf).min(axis=0)
+        row_fraction = np.where(now * ahead < 0.0, now / (now - ahead), np.inf)
+    fraction = row_fraction.min(axis=0)
     crossing = fraction < BRANCH_CROSSING
     landing = (fraction < 1.0) & ~crossing
     shortened = np.where(
         crossing, BRANCH_CROSSING * h, np.where(landing, BRANCH_APPROACH * fraction * h, h)
     )
-    return shortened, landing
+    return shortened, landing, now, row_fraction < BRANCH_CROSSING

@@ -128,7 +128,7 @@ def _integrate(
             raise _unfinished(integrator, text, "max_seconds", "SECONDS", scene, where)
         stats["steps"] += 1
         step = integrator.advance(dynamics, t, y, sizes.propose(dynamics, y, state), state)
-        ok = sizes.judge(step, y)
+        ok = sizes.judge(step, y, dynamics)
         accepted = int(np.count_nonzero(ok))
         stats["accepted_steps"] += accepted
         stats["rejected_steps"] += ok.size - accepted

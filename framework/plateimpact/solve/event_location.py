@@ -55,53 +55,93 @@ def first_event(
     Ties go to the lower event kind, as in :data:`EVENT_NAMES` order.
     """
     m = samples.shape[2]
-    count = margins.shape[0]
     event_sigma, event_kind = np.full(m, np.inf), np.full(m, -1)
     crest_sigma = np.full(m, np.inf)
     turning = samples[OBLIQUITY] - 0.5 * np.pi  # the crest's margin
     cresting = (turning[:-1] < 0.0) & (turning[1:] >= 0.0)
     if margins[:, 1:].max() < 0.0 and not cresting.any():
         return event_sigma, event_kind, crest_sigma  # nothing reaches zero: the usual step
+    crest_rows, crest_at, grazed = _crest(dynamics, margins, turning, cresting, dense, at)
+    crest_sigma[crest_rows] = crest_at
     crossing = (margins[:, :-1] < 0.0) & (margins[:, 1:] >= 0.0)
-    values = np.concatenate([margins, turning[np.newaxis]])  # (events + 1, s, m)
-    bracket = np.concatenate([crossing, cresting[np.newaxis]])
-    has = np.asarray(bracket.any(axis=1))
-    first = np.argmax(bracket, axis=1)  # (events + 1, m)
-    earliest = np.where(has[:count], first[:count], at.size).min(axis=0)
-    candidate = has.copy()
-    candidate[:count] &= first[:count] == earliest
-    kinds, rows = np.nonzero(candidate)
+    for kind, row, interval, _, _ in grazed:
+        crossing[kind, interval, row] = True
+    has = np.asarray(crossing.any(axis=1))
+    first = np.argmax(crossing, axis=1)  # (events, m)
+    earliest = np.where(has, first, at.size).min(axis=0)
+    kinds, rows = np.nonzero(has & (first == earliest))
     if not rows.size:
         return event_sigma, event_kind, crest_sigma
     lo = first[kinds, rows]
     pairs = dynamics.take(rows)
     pair = np.arange(rows.size)
-
-    needed = frozenset(int(k) for k in np.unique(kinds) if k < count)
+    needed = frozenset(int(k) for k in np.unique(kinds))
 
     def margin(state: np.ndarray) -> np.ndarray:
-        every = np.concatenate(
-            [pairs.event_margins(state, needed), (state[OBLIQUITY] - 0.5 * np.pi)[np.newaxis]]
-        )
-        return every[kinds, pair]
+        return pairs.event_margins(state, needed)[kinds, pair]
 
-    located = locate(
-        margin,
-        dense.take(rows),
-        at[lo],
-        at[lo + 1],
-        values[kinds, lo, rows],
-        values[kinds, lo + 1, rows],
-    )
-    crest = kinds == count
-    crest_sigma[rows[crest]] = located[crest]
-    events = ~crest
-    order = np.lexsort((kinds[events], located[events], rows[events]))
-    event_rows = rows[events][order]
-    unique_rows, first_pair = np.unique(event_rows, return_index=True)
-    event_sigma[unique_rows] = located[events][order][first_pair]
-    event_kind[unique_rows] = kinds[events][order][first_pair]
+    hi, f_hi = at[lo + 1], margins[kinds, lo + 1, rows]
+    for kind, row, interval, sigma, value in grazed:  # the bracket ends at the crest
+        at_pair = (kinds == kind) & (rows == row) & (lo == interval)
+        hi, f_hi = np.where(at_pair, sigma, hi), np.where(at_pair, value, f_hi)
+    located = locate(margin, dense.take(rows), at[lo], hi, margins[kinds, lo, rows], f_hi)
+    order = np.lexsort((kinds, located, rows))
+    unique_rows, first_pair = np.unique(rows[order], return_index=True)
+    event_sigma[unique_rows] = located[order][first_pair]
+    event_kind[unique_rows] = kinds[order][first_pair]
     return event_sigma, event_kind, crest_sigma
+
+
+def _crest(
+    dynamics: Dynamics,
+    margins: np.ndarray,
+    turning: np.ndarray,
+    cresting: np.ndarray,
+    dense: DenseOutput,
+    at: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, list[tuple[int, int, int, float, float]]]:
+    """Where θ first crosses 90° upward in the step (the scenes, their σ), and the events
+    that the step's samples miss because their margin rises through zero and falls back
+    between two samples around that crest (where P peaks: failure onset when the deepest
+    penetration just passes P*): (kind, scene, interval, σ of the crest, margin there)
+    for each margin that is < 0 at both samples of the crest's interval and >= 0 at the
+    crest itself; its event lies between the interval's start and the crest. Elsewhere P
+    is monotone within a step, and a sign change at the samples is exact for the margins
+    that follow it."""
+    rows = np.flatnonzero(cresting.any(axis=0))
+    if not rows.size:
+        return rows, np.empty(0), []
+    interval = np.argmax(cresting[:, rows], axis=0)
+
+    def crest_margin(state: np.ndarray) -> np.ndarray:
+        return state[OBLIQUITY] - 0.5 * np.pi
+
+    part = dense.take(rows)
+    lo, hi = at[interval], at[interval + 1]
+    sigma = locate(crest_margin, part, lo, hi, turning[interval, rows], turning[interval + 1, rows])
+    before, after = margins[:, interval, rows], margins[:, interval + 1, rows]
+    # Only a finite margin below zero at both samples can be grazed (-inf: an event that
+    # cannot happen there): the margins at the crest are evaluated for those scenes.
+    possible = ((before < 0.0) & (after < 0.0) & np.isfinite(before)).any(axis=0)
+    if not possible.any():
+        return rows, sigma, []
+    near = np.flatnonzero(possible)
+    at_crest = dynamics.take(rows[near]).event_margins(part.take(near)(sigma[near]))
+    grazed = (before[:, near] < 0.0) & (after[:, near] < 0.0) & (at_crest >= 0.0)
+    return (
+        rows,
+        sigma,
+        [
+            (
+                int(k),
+                int(rows[near[j]]),
+                int(interval[near[j]]),
+                float(sigma[near[j]]),
+                float(at_crest[k, j]),
+            )
+            for k, j in zip(*np.nonzero(grazed), strict=True)
+        ],  # fmt: skip
+    )
 
 
 def locate(
