@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import final
+from typing import Any, final
 
 import attrs
 import numpy as np
@@ -30,6 +30,89 @@ HINGE_OBLIQUITY = Parameter(
     np.pi / 180,
     default=None,
     optional=True,
+)
+
+
+def finger_half_angle(finger_angle: Any) -> Any:
+    """β/2 [rad] of the finger angle β [rad], 0 once the finger has peeled off."""
+    return 0.5 * np.maximum(finger_angle, 0.0)
+
+
+def finger_area(half_angle: Any, radius: Any, area_scale: Any) -> Any:
+    """As = π [Rs sin(β/2)]² [m²] (eq 17), times ``area_scale``; β/2 [rad], Rs [m]."""
+    return area_scale * np.pi * (radius * np.sin(half_angle)) ** 2
+
+
+def rising_finger_incidence(obliquity: Any, opening: Any, half_angle: Any) -> Any:
+    """ψ″ = 90° + θ − θ1 − β/2 [rad] (eq 19, θ < θ1), with ``opening`` 90° − θ1 [rad]."""
+    return obliquity + (opening - half_angle)
+
+
+def rolling_finger_incidence(half_angle: Any) -> Any:
+    """ψ″ = 90° − β/2 [rad] (eq 20, θ >= θ1)."""
+    return HALF_PI - half_angle
+
+
+def finger_kernel(
+    obliquity: float,
+    finger_angle: float,
+    radius: float,
+    theta1: float,
+    opening: float,
+    area_scale: float,
+) -> tuple[float, float]:
+    """:meth:`Hinge.finger` of numbers, (As [m²], ψ″ [rad]), for a compiled path."""
+    half_angle = finger_half_angle(finger_angle)
+    area = finger_area(half_angle, radius, area_scale)
+    if obliquity < theta1:
+        return area, rising_finger_incidence(obliquity, opening, half_angle)
+    return area, rolling_finger_incidence(half_angle)
+
+
+def initial_finger_angle(obliquity: Any, failure_angle: Any, theta1: Any) -> Any:
+    """β at onset [rad]: 2α* − max(θ − θ1, 0), from θ, α* and θ1 [rad]."""
+    return 2.0 * failure_angle - np.maximum(obliquity - theta1, 0.0)
+
+
+def finger_is_held(obliquity: Any, finger_angle: Any, failure_angle: Any, theta1: Any) -> Any:
+    """True while β [rad] neither shrinks nor acts as shrinking: held at 2α* while θ <=
+    θ1, or peeled off (β <= 0); θ, α*, θ1 [rad]."""
+    held = (obliquity <= theta1) & (finger_angle >= 2.0 * failure_angle)
+    return held | (finger_angle <= 0.0)
+
+
+def peeling_rate(obliquity_rate: Any, speed: Any, radius: Any) -> Any:
+    """−dβ/dt [rad/s] of a shrinking finger: dθ/dt + V/Rs (eq 18 per unit time), never
+    negative (a finger does not re-attach); dθ/dt [rad/s], V [m/s], Rs [m]."""
+    return np.maximum(obliquity_rate + speed / radius, 0.0)
+
+
+def finger_rate_kernel(
+    obliquity: float,
+    finger_angle: float,
+    obliquity_rate: float,
+    speed: float,
+    radius: float,
+    failure_angle: float,
+    theta1: float,
+) -> float:
+    """dβ/dt [rad/s] of numbers (:meth:`Hinge.state_rates`), for a compiled path."""
+    if finger_is_held(obliquity, finger_angle, failure_angle, theta1):
+        return 0.0
+    return -peeling_rate(obliquity_rate, speed, radius)
+
+
+#: The functions of numbers a compiled path compiles (callees before callers).
+KERNELS = (
+    finger_half_angle,
+    finger_area,
+    rising_finger_incidence,
+    rolling_finger_incidence,
+    finger_kernel,
+    initial_finger_angle,
+    finger_is_held,
+    peeling_rate,
+    finger_rate_kernel,
 )
 
 
@@ -96,17 +179,16 @@ class Hinge(PlaneSeparation):
 
     def initial_state(self, contact: Contact) -> np.ndarray:
         scenes = contact.scenes
-        full = 2.0 * scenes.failure_angle
-        return (full - np.maximum(contact.obliquity - scenes.theta1, 0.0))[np.newaxis]
+        onset = initial_finger_angle(contact.obliquity, scenes.failure_angle, scenes.theta1)
+        return onset[np.newaxis]
 
     def state_rates(self, contact: Contact) -> np.ndarray:
         scenes, obliquity = contact.scenes, contact.obliquity
         assert contact.obliquity_rate is not None  # given wherever rates are asked for
         finger_angle = contact.failure_state[0]
-        held = (obliquity <= scenes.theta1) & (finger_angle >= 2.0 * scenes.failure_angle)
-        # eq 18 per unit time
-        peeling = np.maximum(contact.obliquity_rate + contact.speed / scenes.radius, 0.0)
-        return np.where(held | (finger_angle <= 0.0), 0.0, -peeling)[np.newaxis]
+        held = finger_is_held(obliquity, finger_angle, scenes.failure_angle, scenes.theta1)
+        peeling = peeling_rate(contact.obliquity_rate, contact.speed, scenes.radius)
+        return np.where(held, 0.0, -peeling)[np.newaxis]
 
     def branch_margins(self, contact: Contact) -> np.ndarray:
         # Besides the relief's: θ − θ1 [rad], where ψ″ switches from eq 19 to eq 20 and β
@@ -122,15 +204,14 @@ class Hinge(PlaneSeparation):
         from the path (eqs 19–20), at obliquity θ [rad] and finger angle β [rad]. The
         finger touches the sphere over the cap of angular width β centred on that force
         line, i.e. from θ − ψ″ − β/2 to θ − ψ″ + β/2 from the plate normal."""
-        half_angle = 0.5 * np.maximum(finger_angle, 0.0)
-        area = self.finger_area_scale * np.pi * (scenes.radius * np.sin(half_angle)) ** 2
-        theta1 = scenes.theta1
+        half_angle = finger_half_angle(finger_angle)
+        area = finger_area(half_angle, scenes.radius, self.finger_area_scale)
         incidence = np.where(
-            obliquity < theta1,
-            obliquity + (scenes.hinge_opening - half_angle),  # eq 19: 90° + θ − θ1 − β/2
-            HALF_PI - half_angle,  # eq 20
+            obliquity < scenes.theta1,
+            rising_finger_incidence(obliquity, scenes.hinge_opening, half_angle),  # eq 19
+            rolling_finger_incidence(half_angle),  # eq 20
         )
-        return area, incidence
+        return area, incidence  # (finger_kernel: the same for numbers)
 
     def force_change(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         drag, lift = self.relief(contact)

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from abc import abstractmethod
-from typing import ClassVar
+from collections.abc import Callable
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -11,6 +12,45 @@ from plateimpact import Column, Contact, FailureModel, Parameter, SceneBatch, ge
 
 from .report.constants import FAILURE_ANGLE
 from .report.plane import failure_plane_depth
+
+
+def plane_relief(
+    force: Callable[..., tuple[Any, Any]],
+    force_args: tuple[Any, ...],
+    penetration: Any,
+    obliquity: Any,
+    speed: Any,
+    plane_depth: Any,
+) -> tuple[Any, Any]:
+    """−F′ as (drag, lift) [N] (eq 15): the force ``force(P − h, θ, V, *force_args)`` of
+    the resistance law on the contact surface below the failure plane at depth
+    ``plane_depth`` h [m] (eqs 9–14), no longer exerted; P [m], θ [rad], V [m/s]. On
+    arrays (``force``: the law's ``contact_force``) and on numbers (a compiled
+    ``force_on_contact``) alike."""
+    relieved_drag, relieved_lift = force(penetration - plane_depth, obliquity, speed, *force_args)
+    return -relieved_drag, -relieved_lift
+
+
+def plane_perforation_margin(
+    penetration: Any, obliquity: Any, radius: Any, plane_depth: Any
+) -> Any:
+    """Depth [m] of the forward hemisphere's shallowest point below the failure plane at
+    ``plane_depth`` h [m]: P − h − Rs(1 + sin min(θ, π/2)), >= 0 once the front layer no
+    longer touches it (perforation); P [m], θ [rad], Rs [m], numbers or arrays."""
+    reach = radius * (1.0 + np.sin(np.minimum(obliquity, 0.5 * np.pi)))
+    return penetration - plane_depth - reach
+
+
+def plane_branch_surfaces(
+    penetration: Any, obliquity: Any, radius: Any, plane_depth: Any
+) -> tuple[Any, Any]:
+    """The branch surfaces of the relieved force [m]: eqs 2–6 below the failure plane at
+    ``plane_depth`` h [m], i.e. with P − h for P (:func:`plateimpact.geometry.branch_surfaces`)."""
+    return geometry.branch_surfaces(penetration - plane_depth, obliquity, radius)
+
+
+#: The functions of numbers a compiled path compiles (besides the core's geometry).
+KERNELS = (failure_plane_depth, plane_relief, plane_perforation_margin, plane_branch_surfaces)
 
 
 class PlaneSeparation(FailureModel):
@@ -46,24 +86,28 @@ class PlaneSeparation(FailureModel):
 
     def relief(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""
-        below_plane = contact.penetration - contact.scenes.failure_plane_depth
-        relieved_drag, relieved_lift = contact.law.contact_force(
-            below_plane, contact.obliquity, contact.speed
+        return plane_relief(
+            contact.law.contact_force,
+            (),
+            contact.penetration,
+            contact.obliquity,
+            contact.speed,
+            contact.scenes.failure_plane_depth,
         )
-        return -relieved_drag, -relieved_lift
 
     def force_change(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         return self.relief(contact)
 
     def branch_margins(self, contact: Contact) -> np.ndarray:
-        # The relieved force is eqs 2–6 below the failure plane: the same branch surfaces
-        # with P − h for P [m].
         scenes = contact.scenes
-        below_plane = contact.penetration - scenes.failure_plane_depth
-        return geometry.branch_margins(below_plane, contact.obliquity, scenes.radius)
+        return np.stack(
+            plane_branch_surfaces(
+                contact.penetration, contact.obliquity, scenes.radius, scenes.failure_plane_depth
+            )
+        )
 
     def perforation_margin(self, contact: Contact) -> np.ndarray:
-        # Depth of the forward hemisphere's shallowest point below the failure plane.
         scenes = contact.scenes
-        reach = scenes.radius * (1.0 + np.sin(np.minimum(contact.obliquity, 0.5 * np.pi)))
-        return contact.penetration - scenes.failure_plane_depth - reach
+        return plane_perforation_margin(
+            contact.penetration, contact.obliquity, scenes.radius, scenes.failure_plane_depth
+        )

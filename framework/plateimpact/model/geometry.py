@@ -9,7 +9,12 @@ The **contact surface** is the part of the sphere that is below the front surfac
 the forward hemisphere. Its projection on the contact plane is the presented area A; the
 force acts along the contact-plane normal, at the inclination φ from the plate normal.
 
-Every function takes arrays (one value per scene) and broadcasts. All arccos/arcsin
+Each formula is written once, in numpy ufuncs and arithmetic only, so that the same
+function runs on arrays (one value per scene, the numpy path) and on numbers (numba
+compiles it for a per-scene loop, the compiled path) with the same results. Where a
+formula switches branch per scene (the turn-around ring of eq 6), an array function
+selects with a mask and a ``*_kernel`` twin with an ``if``, both calling the same
+formulas; :data:`KERNELS` lists what a compiled path compiles. All arccos/arcsin
 arguments are clamped to [−1, 1]: they leave it in legitimate states (docs/model.md §2,
 "Clamps"), and the clamped values are the report's own special cases ("then Γe = 2π",
 "then Γs = 0").
@@ -18,18 +23,21 @@ For the plugging relief (eqs 9–13), call the same functions with P − h in pl
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 HALF_PI = 0.5 * np.pi
 TWO_PI = 2.0 * np.pi
 
 
-def _clamp(value: np.ndarray, low: float | np.ndarray, high: float | np.ndarray) -> np.ndarray:
-    """np.clip at a third of its call overhead (the geometry runs six times a step)."""
+def _clamp(value: Any, low: Any, high: Any) -> Any:
+    """np.clip at a third of its call overhead (the geometry runs six times a step), and a
+    form numba compiles for numbers too."""
     return np.minimum(np.maximum(value, low), high)
 
 
-def embedment_radius_squared(penetration: np.ndarray, radius: np.ndarray) -> np.ndarray:
+def embedment_radius_squared(penetration: Any, radius: Any) -> Any:
     """Re², the squared radius of the circle cut by the front plane (eq 3) [m²].
 
     Zero when the sphere does not reach the plane (P <= 0) or has passed it (P >= 2 Rs).
@@ -37,18 +45,45 @@ def embedment_radius_squared(penetration: np.ndarray, radius: np.ndarray) -> np.
     return np.maximum(penetration * (2.0 * radius - penetration), 0.0)
 
 
-def entry_edge_angle(penetration: np.ndarray, radius: np.ndarray) -> np.ndarray:
+def entry_edge_angle(penetration: Any, radius: Any) -> Any:
     """α1 [rad]: angle, at the centre and from the inward normal, of the point where the
     front surface cuts the sphere in the plane of motion. 0 at first contact, π/2 when
     the centre reaches the surface, π once the sphere is wholly below it."""
     return np.arccos(_clamp((radius - penetration) / radius, -1.0, 1.0))
 
 
-def force_inclination(
-    penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
-) -> np.ndarray:
+def inclination_bisector(alpha1: Any, obliquity: Any) -> Any:
+    """½[α1 + θ − π/2] [rad], the bisector of the contact arc's ends α1 and θ − π/2 (eq 6
+    before its clamp), from α1 and the obliquity θ [rad]."""
+    return 0.5 * (alpha1 + obliquity - HALF_PI)
+
+
+def in_turnaround_ring(alpha1: Any, obliquity: Any) -> Any:
+    """True where a deep sphere that has turned outward touches the plate on both sides of
+    its entry hole (θ + π/2 > 2π − α1), where eq 6 gives way to :func:`ring_inclination`."""
+    return obliquity + HALF_PI > TWO_PI - alpha1
+
+
+def ring_inclination(alpha1: Any, obliquity: Any, bisector: Any) -> Any:
+    """φ [rad] in the turn-around ring: the normal to the sum of the chords of the two
+    contact arcs (θ − π/2, α1) and (2π − α1, θ + π/2), from α1, θ [rad] and the eq 6
+    ``bisector`` (the first chord's normal)."""
+    first = np.sin(0.5 * (alpha1 - obliquity + HALF_PI))  # chord lengths / 2Rs
+    second = np.sin(0.5 * (obliquity + alpha1 - 1.5 * np.pi))
+    second_normal = 0.5 * (obliquity + 2.5 * np.pi - alpha1)
+    ring_phi = np.arctan2(
+        first * np.sin(bisector) + second * np.sin(second_normal),
+        first * np.cos(bisector) + second * np.cos(second_normal),
+    )
+    # φ <= θ holds analytically (the longer arc lies behind the path); the clip only
+    # removes arctan2 round-off near θ = π, where the two chords nearly cancel.
+    return np.minimum(ring_phi + TWO_PI * (ring_phi < 0.0), obliquity)
+
+
+def force_inclination(penetration: Any, obliquity: Any, radius: Any) -> np.ndarray:
     """φ [rad], the angle of the contact-plane normal (the force) from the plate normal;
-    ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m], one per scene.
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m], arrays with one
+    value per scene (:func:`force_inclination_kernel` is the same for numbers).
 
     The contact chord joins the two ends of the contact arc in the plane of motion; φ is
     its normal, i.e. the bisector of the ends. Eq 6 is that bisector with the upper end at
@@ -64,51 +99,68 @@ def force_inclination(
     symmetric about the path.
     """
     alpha1 = entry_edge_angle(penetration, radius)
-    bisector = 0.5 * (alpha1 + obliquity - HALF_PI)  # eq 6
-    phi = _clamp(bisector, 0.0, obliquity)
-    ring = obliquity + HALF_PI > TWO_PI - alpha1
-    if ring.any():
-        # Chord lengths (/2Rs) and normal directions of the two arcs of the ring regime:
-        # (θ − π/2, α1) and (2π − α1, θ + π/2).
-        th, a1, b1 = obliquity[ring], alpha1[ring], bisector[ring]
-        first = np.sin(0.5 * (a1 - th + HALF_PI))
-        second = np.sin(0.5 * (th + a1 - 1.5 * np.pi))
-        second_normal = 0.5 * (th + 2.5 * np.pi - a1)
-        ring_phi = np.arctan2(
-            first * np.sin(b1) + second * np.sin(second_normal),
-            first * np.cos(b1) + second * np.cos(second_normal),
-        )
-        # φ <= θ holds analytically (the longer arc lies behind the path); the clip only
-        # removes arctan2 round-off near θ = π, where the two chords nearly cancel.
-        phi[ring] = np.minimum(np.where(ring_phi < 0.0, ring_phi + TWO_PI, ring_phi), th)
+    bisector = inclination_bisector(alpha1, obliquity)
+    phi = _clamp(bisector, 0.0, obliquity)  # eq 6
+    ring = in_turnaround_ring(alpha1, obliquity)
+    if ring.any():  # rare: the ring's arctan2 only where it applies
+        phi[ring] = ring_inclination(alpha1[ring], obliquity[ring], bisector[ring])
     return phi
 
 
-def _limit_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
+def force_inclination_kernel(penetration: float, obliquity: float, radius: float) -> float:
+    """:func:`force_inclination` of numbers [rad], for a compiled path: the same formulas,
+    selected per scene."""
+    alpha1 = entry_edge_angle(penetration, radius)
+    bisector = inclination_bisector(alpha1, obliquity)
+    if in_turnaround_ring(alpha1, obliquity):
+        return ring_inclination(alpha1, obliquity, bisector)
+    return _clamp(bisector, 0.0, obliquity)  # eq 6
+
+
+def limit_ratio(numerator: Any, denominator: Any) -> Any:
     """numerator/denominator clipped to [−1, 1], for denominator >= 0, with the limit at
     denominator = 0: ±1 by the sign of the numerator, and 0 for 0/0 (the limit θ → 0 at
-    P = Rs)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        ratio = numerator / denominator  # ±inf (zero or subnormal denominator) clips to ±1
-    np.maximum(ratio, -1.0, out=ratio)
-    np.minimum(ratio, 1.0, out=ratio)
-    undefined = np.isnan(ratio)  # 0/0 only: a zero denominator otherwise gives ±inf
-    if undefined.any():
-        ratio[undefined] = 0.0
-    return ratio
+    P = Rs). A zero numerator divides by denominator + 1, so 0/0 never arises; a zero
+    denominator otherwise gives ±inf, which clips to ±1 (callers on arrays silence the
+    divide warning)."""
+    ratio = numerator / (denominator + (numerator == 0.0))
+    return _clamp(ratio, -1.0, 1.0)
 
 
-def contact_geometry(
-    penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Presented area A [m²] (eq 2) and force inclination φ [rad] (eq 6) at
-    ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m], one per scene.
+def presented_area(penetration: Any, obliquity: Any, radius: Any, inclination: Any) -> Any:
+    """Presented area A [m²] (eq 2) at ``penetration`` P [m], ``obliquity`` θ [rad] in
+    [0, π], ``radius`` Rs [m] and force ``inclination`` φ [rad]: the formula once, on
+    numbers or arrays (numpy ufuncs only, so a compiled path compiles this very function).
 
     A is the projection of the contact surface on the contact plane. By the divergence
     theorem it equals the projections of the two flat faces that close the contact
     surface: the forward segment of the front-plane disc (radius Re, central angle Γe,
     eq 4) and the below-surface segment of the great disc normal to the velocity (radius
     Rs, central angle Γs, eq 5).
+    """
+    centre_height = radius - penetration  # height of the centre above the front plane
+    re_squared = embedment_radius_squared(penetration, radius)
+    sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
+    # eq 4, (Rs − P)/(Re tan θ) written with sin and cos so that θ = 0 is a limit.
+    ratio_e = limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t)
+    ratio_s = limit_ratio(centre_height, radius * sin_t)  # eq 5
+    # Γ − sin Γ for Γe = 2π − 2 arccos r and Γs = 2 arccos r, with sin(2 arccos r) written
+    # as 2 r √(1 − r²): the same values without two more sine evaluations.
+    chord_e = 2.0 * ratio_e * np.sqrt(1.0 - ratio_e * ratio_e)
+    chord_s = 2.0 * ratio_s * np.sqrt(1.0 - ratio_s * ratio_s)
+    segment_e = TWO_PI - 2.0 * np.arccos(ratio_e) + chord_e  # Γe − sin Γe
+    segment_s = 2.0 * np.arccos(ratio_s) - chord_s  # Γs − sin Γs
+    return 0.5 * re_squared * segment_e * np.cos(inclination) + 0.5 * radius**2 * segment_s * (
+        np.cos(obliquity - inclination)
+    )  # eq 2
+
+
+def contact_geometry(
+    penetration: Any, obliquity: Any, radius: Any
+) -> tuple[np.ndarray, np.ndarray]:
+    """Presented area A [m²] (eq 2, :func:`presented_area`) and force inclination φ [rad]
+    (eq 6, :func:`force_inclination`) at ``penetration`` P [m], ``obliquity`` θ [rad] and
+    ``radius`` Rs [m], one per scene (:func:`contact_geometry_kernel`: for numbers).
 
     Parameters
     ----------
@@ -119,32 +171,22 @@ def contact_geometry(
     radius = np.asarray(radius, dtype=float)
     if not penetration.shape == obliquity.shape == radius.shape:
         penetration, obliquity, radius = np.broadcast_arrays(penetration, obliquity, radius)
-
-    centre_height = radius - penetration  # height of the centre above the front plane
-    re_squared = embedment_radius_squared(penetration, radius)
-    sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
-    # eq 4, (Rs − P)/(Re tan θ) written with sin and cos so that θ = 0 is a limit.
-    ratio_e = _limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t)
-    ratio_s = _limit_ratio(centre_height, radius * sin_t)  # eq 5
-    # Γ − sin Γ for Γe = 2π − 2 arccos r and Γs = 2 arccos r, with sin(2 arccos r) written
-    # as 2 r √(1 − r²): the same values without two more sine evaluations.
-    chord_e = 2.0 * ratio_e * np.sqrt(1.0 - ratio_e * ratio_e)
-    chord_s = 2.0 * ratio_s * np.sqrt(1.0 - ratio_s * ratio_s)
-    segment_e = TWO_PI - 2.0 * np.arccos(ratio_e) + chord_e  # Γe − sin Γe
-    segment_s = 2.0 * np.arccos(ratio_s) - chord_s  # Γs − sin Γs
-
     phi = force_inclination(penetration, obliquity, radius)
-    area = 0.5 * re_squared * segment_e * np.cos(phi) + 0.5 * radius**2 * segment_s * np.cos(
-        obliquity - phi
-    )  # eq 2
-    return area, phi
+    with np.errstate(divide="ignore", over="ignore"):  # limit_ratio's ±inf clip to ±1
+        return presented_area(penetration, obliquity, radius, phi), phi
 
 
-def branch_margins(
-    penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
-) -> np.ndarray:
-    """P − Rs(1 − sin θ) and P − Rs(1 + sin θ) [m], shape (2, n): zero on the two surfaces
-    where eqs 2–6 change branch.
+def contact_geometry_kernel(
+    penetration: float, obliquity: float, radius: float
+) -> tuple[float, float]:
+    """:func:`contact_geometry` of numbers, (A [m²], φ [rad]), for a compiled path."""
+    phi = force_inclination_kernel(penetration, obliquity, radius)
+    return presented_area(penetration, obliquity, radius, phi), phi
+
+
+def branch_surfaces(penetration: Any, obliquity: Any, radius: Any) -> tuple[Any, Any]:
+    """P − Rs(1 − sin θ) and P − Rs(1 + sin θ) [m], numbers or arrays: zero on the two
+    surfaces where eqs 2–6 change branch.
 
     On the first, the edge of the forward hemisphere reaches the front plane (Γs leaves 0,
     Γe leaves 2π, φ leaves its clamp at 0); on the second, it leaves the plate at the
@@ -154,12 +196,15 @@ def branch_margins(
     them (docs/integrators.md, "branch surfaces"). θ in [0, π].
     """
     lift = radius * np.sin(obliquity)
-    return np.stack([penetration - (radius - lift), penetration - (radius + lift)])
+    return penetration - (radius - lift), penetration - (radius + lift)
 
 
-def contact_lost_margin(
-    penetration: np.ndarray, obliquity: np.ndarray, radius: np.ndarray
-) -> np.ndarray:
+def branch_margins(penetration: Any, obliquity: Any, radius: Any) -> np.ndarray:
+    """:func:`branch_surfaces` [m] as rows, shape (2, n), for arrays of n scenes."""
+    return np.stack(branch_surfaces(penetration, obliquity, radius))
+
+
+def contact_lost_margin(penetration: Any, obliquity: Any, radius: Any) -> Any:
     """>= 0 once the sphere moves away from every point of the plate (the forward
     hemisphere and the below-surface cap no longer meet): θ − π/2 >= α1, at
     ``penetration`` P [m], ``obliquity`` θ [rad] and ``radius`` Rs [m]; the margin [m].
@@ -172,3 +217,20 @@ def contact_lost_margin(
     fewer iterations. θ in [0, π].
     """
     return np.minimum(obliquity - HALF_PI, (radius - penetration) / radius - np.sin(obliquity))
+
+
+#: The functions of numbers a compiled path compiles (callees before callers).
+KERNELS = (
+    _clamp,
+    embedment_radius_squared,
+    entry_edge_angle,
+    inclination_bisector,
+    in_turnaround_ring,
+    ring_inclination,
+    force_inclination_kernel,
+    limit_ratio,
+    presented_area,
+    contact_geometry_kernel,
+    branch_surfaces,
+    contact_lost_margin,
+)

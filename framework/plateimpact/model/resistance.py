@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -39,6 +41,30 @@ class ResistanceLaw(Plugin, ABC):
         """
 
 
+def force_on_contact(
+    penetration: Any,
+    obliquity: Any,
+    speed: Any,
+    radius: Any,
+    geometry: Callable[..., tuple[Any, Any]],
+    stress: Callable[..., Any],
+    stress_args: tuple[Any, ...],
+) -> tuple[Any, Any]:
+    """Drag and lift [N] on the contact surface (eqs 1, 22–24) at ``penetration`` P [m],
+    ``obliquity`` θ [rad] and ``speed`` V [m/s] of a sphere of ``radius`` Rs [m]: the
+    formula once, for arrays and numbers alike.
+
+    ``geometry(P, θ, Rs)`` gives the presented area A [m²] and force inclination φ [rad]
+    (:func:`~plateimpact.model.geometry.contact_geometry` on arrays, its ``_kernel`` on
+    numbers) and ``stress(V, ψ, *stress_args)`` the stress σ [N/m²] (a law's ``stress``
+    with its view of the scenes, or a compiled stress kernel with its constants).
+    """
+    area, inclination = geometry(penetration, obliquity, radius)
+    incidence = obliquity - inclination  # ψ, eq 22
+    force = area * stress(speed, incidence, *stress_args)  # eq 1
+    return force * np.cos(incidence), force * np.sin(incidence)  # eqs 23, 24
+
+
 def contact_force(
     law: ResistanceLaw,
     penetration: np.ndarray,
@@ -47,17 +73,17 @@ def contact_force(
     batch: SceneBatch,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Drag and lift [N] of ``law`` on the contact surface (eqs 1, 22–24) at
-    ``penetration`` P [m], ``obliquity`` θ [rad] and ``speed`` V [m/s], one per scene.
+    ``penetration`` P [m], ``obliquity`` θ [rad] and ``speed`` V [m/s], one per scene
+    (:func:`force_on_contact` on arrays).
 
     ``penetration`` is measured from the plane bounding the resisting material: the front
     surface for the intact force F*, the failure plane (P − h) for the relieved force F′
     of eqs 9–14. Drag opposes the motion; positive lift turns θ upward (toward ricochet).
     ``batch`` is the law's view of the scenes.
     """
-    area, inclination = contact_geometry(penetration, obliquity, batch.radius)
-    incidence = obliquity - inclination  # ψ, eq 22
-    force = area * law.stress(speed, incidence, batch)  # eq 1
-    return force * np.cos(incidence), force * np.sin(incidence)  # eqs 23, 24
+    return force_on_contact(
+        penetration, obliquity, speed, batch.radius, contact_geometry, law.stress, (batch,)
+    )
 
 
 class BoundResistance:
