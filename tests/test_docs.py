@@ -39,6 +39,7 @@ def lines_in_order(block: str, module: str) -> bool:
     "name, module",
     [
         ("RatePoncelet", "__init__.py"),
+        ("IsotropicPoncelet", "__init__.py"),
         ("Brittle", "brittle.py"),
         ("ClassicalRungeKutta", "rk4.py"),
     ],
@@ -134,3 +135,24 @@ def test_the_pages_integrator_fits_in_sixty_lines():
 def test_the_pages_integrator_is_listed_with_its_settings(docs_registry, name):
     settings = docs_registry.get("integrator", name).setting_declarations()
     assert set(settings) == {"step", "max_steps"}
+
+
+def test_the_pages_compiled_plug_in_runs_compiled_with_the_numpy_paths_results(docs_registry):
+    """The page's kernel opts the isotropic law into the compiled path: a large run takes
+    it, and agrees with the numpy path within what the tolerance promises."""
+    pytest.importorskip("numba")
+    plate = presets.plate("2024-T3/3.18")
+    scenes = pi.SceneBatch.grid(SPHERE, plate, np.linspace(100.0, 1400.0, 50), np.radians(
+        np.linspace(0.0, 75.0, 40)
+    ))  # fmt: skip
+    runs = {
+        engine: pi.Simulation.from_names(
+            resistance="isotropic-poncelet", registry=docs_registry, engine=engine
+        ).run_batch(scenes)
+        for engine in ("auto", "numpy")
+    }
+    assert runs["auto"].stats["compiled_scenes"] == scenes.size == 2000
+    assert runs["numpy"].stats["compiled_scenes"] == 0
+    np.testing.assert_array_equal(runs["auto"].outcome, runs["numpy"].outcome)
+    speed = scenes.columns["impact_speed"]
+    assert np.max(np.abs(runs["auto"].exit_speed - runs["numpy"].exit_speed) / speed) <= 2e-7

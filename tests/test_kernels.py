@@ -139,7 +139,8 @@ def _force_per_scene(compiled, states, depth=None):
         if depth is None:
             out.append(force(p, theta, speed, *args))
         else:
-            out.append(compiled["plane_relief"](force, args, p, theta, speed, float(depth[i])))
+            drag, lift = force(p - float(depth[i]), theta, speed, *args)  # F′ below the plane
+            out.append((-drag, -lift))  # eq 15: the relief
     return np.array(out).T
 
 

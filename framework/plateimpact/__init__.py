@@ -28,6 +28,8 @@ _EXPORTS: dict[str, str] = {
     "contact_force": "model.resistance",
     "FailureModel": "model.failure",
     "Contact": "model.failure",
+    "FailureKernels": "model.kernels",
+    "KernelContact": "model.kernels",
     "Event": "model.events",
     "EVENTS": "model.events",
     "FAILURE_EVENTS": "model.events",
@@ -37,6 +39,7 @@ _EXPORTS: dict[str, str] = {
     "REST": "model.events",
     "TURN_BACK": "model.events",
     "Integrator": "solve.integrator",
+    "PairTableau": "solve.integrator",
     "Step": "solve.integrator",
     "StepControl": "solve.integrator",
     "StepperState": "solve.integrator",
@@ -118,6 +121,7 @@ _EXPORTS: dict[str, str] = {
     "PlateImpactWarning": "base.errors",
     "ArchiveWaitWarning": "base.errors",
     "PluginLoadWarning": "base.errors",
+    "CompiledPathWarning": "base.errors",
     # files from someone else (a plug-in that reads a file a user names checks it first)
     "check_input": "base.untrusted",
     "load_json": "base.untrusted",
@@ -130,6 +134,7 @@ _SUBMODULES: dict[str, str] = {
     "command_line": "cli.toolkit",
     "experiment": "experiment",
     "geometry": "model.geometry",
+    "kernels": "model.kernels",
     "limits": "limits",
     "presets": "registry.presets",
     "units": "units",
@@ -198,6 +203,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         ArchiveError,
         ArchiveWaitWarning,
         CalibrationError,
+        CompiledPathWarning,
         ConvergenceError,
         IntegrationError,
         ParameterError,
@@ -218,7 +224,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .comparison import Comparison
     from .experiment import ValidationReport, validate
     from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots
-    from .model import batch, geometry
+    from .model import batch, geometry, kernels
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
     from .model.events import (
@@ -248,6 +254,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         SPEED,
         ImpactModel,
     )
+    from .model.kernels import FailureKernels, KernelContact
     from .model.plugin import Column, Plugin
     from .model.ragged import Ragged
     from .model.resistance import BoundResistance, ResistanceLaw, contact_force
@@ -266,6 +273,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
         MAX_STEPS,
         RTOL,
         Integrator,
+        PairTableau,
         Step,
         StepControl,
         StepperState,

@@ -14,6 +14,7 @@ from plateimpact import (
     DenseOutput,
     Dynamics,
     Integrator,
+    PairTableau,
     Parameter,
     PolynomialDenseOutput,
     Range,
@@ -109,6 +110,11 @@ class EmbeddedRungeKutta(Integrator):
         if self.fixed_step is not None:
             return None
         return StepControl(self.rtol, self.error_order, self.branch_landing)
+
+    def compiled_tableau(self) -> PairTableau | None:
+        if self.fixed_step is not None:  # fixed steps: the numpy path's convergence studies
+            return None
+        return PairTableau(self.C, self.A, self.B, self.E, self.P, self.error_order)
 
     def initial_step(self, dynamics: Dynamics) -> np.ndarray:
         fraction = FIRST_STEP if self.fixed_step is None else self.fixed_step

@@ -7,10 +7,24 @@ from typing import Any, final
 import attrs
 import numpy as np
 
-from plateimpact import Column, Contact, Parameter, Range, SceneBatch
+from plateimpact import (
+    Column,
+    Contact,
+    FailureKernels,
+    KernelContact,
+    Parameter,
+    Range,
+    SceneBatch,
+    kernels,
+)
 
 from .report.constants import CRITICAL_PENETRATION, FAILURE_ANGLE
-from .separation import PlaneSeparation
+from .separation import (
+    PlaneSeparation,
+    separation_branch_margins,
+    separation_force_change,
+    separation_perforation_margin,
+)
 
 HALF_PI = 0.5 * np.pi
 
@@ -102,6 +116,44 @@ def finger_rate_kernel(
     return -peeling_rate(obliquity_rate, speed, radius)
 
 
+# The hinge's kernel constants: h, θ1, 90° − θ1, α* [m, rad, rad, rad], finger_area_scale.
+_DEPTH, _THETA1, _OPENING, _ALPHA, _SCALE = range(5)
+
+
+def hinge_force_change(contact: KernelContact) -> tuple[float, float]:
+    """:meth:`Hinge.force_change` of one scene: the relief and the finger (eqs 15-21)."""
+    c = contact.constants
+    drag, lift = separation_force_change(contact)
+    area, incidence = finger_kernel(
+        contact.obliquity, contact.failure_state[0], contact.radius, c[_THETA1], c[_OPENING],
+        c[_SCALE],
+    )  # fmt: skip
+    finger_force = area * kernels.law_stress(contact.speed, incidence, contact)  # eq 16
+    return drag + finger_force * np.cos(incidence), lift + finger_force * np.sin(incidence)
+
+
+def hinge_branch_margins(contact: KernelContact, out: Any) -> None:
+    """:meth:`Hinge.branch_margins` of one scene, into ``out[0:4]``."""
+    separation_branch_margins(contact, out)
+    out[2] = contact.obliquity - contact.constants[_THETA1]
+    out[3] = contact.failure_state[0]
+
+
+def hinge_initial_state(contact: KernelContact, out: Any) -> None:
+    """:meth:`Hinge.initial_state` of one scene: β at onset [rad]."""
+    c = contact.constants
+    out[0] = initial_finger_angle(contact.obliquity, c[_ALPHA], c[_THETA1])
+
+
+def hinge_state_rates(contact: KernelContact, out: Any) -> None:
+    """:meth:`Hinge.state_rates` of one scene: dβ/dt [rad/s]."""
+    c = contact.constants
+    out[0] = finger_rate_kernel(
+        contact.obliquity, contact.failure_state[0], contact.obliquity_rate, contact.speed,
+        contact.radius, c[_ALPHA], c[_THETA1],
+    )  # fmt: skip
+
+
 #: The functions of numbers a compiled path compiles (callees before callers).
 KERNELS = (
     finger_half_angle,
@@ -113,6 +165,10 @@ KERNELS = (
     finger_is_held,
     peeling_rate,
     finger_rate_kernel,
+    hinge_force_change,
+    hinge_branch_margins,
+    hinge_initial_state,
+    hinge_state_rates,
 )
 
 
@@ -160,8 +216,22 @@ class Hinge(PlaneSeparation):
         Column("hinge_opening", "rad", "90 deg - theta1"),
     )
 
+    kernels = FailureKernels(
+        hinge_force_change,
+        separation_perforation_margin,
+        branch_rows=4,
+        branch_margins=hinge_branch_margins,
+        initial_state=hinge_initial_state,
+        state_rates=hinge_state_rates,
+    )
+
     finger_area_scale: float = FINGER_AREA_SCALE.field()
     hinge_obliquity: float | None = HINGE_OBLIQUITY.field()
+
+    def kernel_constants(self, scenes: SceneBatch) -> np.ndarray:
+        scale = np.full(scenes.size, self.finger_area_scale)
+        columns = (scenes.failure_plane_depth, scenes.theta1, scenes.hinge_opening)
+        return np.stack([*columns, scenes.failure_angle, scale])
 
     def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:
         return scenes.critical_penetration

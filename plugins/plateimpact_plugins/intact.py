@@ -7,7 +7,21 @@ from typing import final
 import attrs
 import numpy as np
 
-from plateimpact import Contact, FailureModel, SceneBatch
+from plateimpact import Contact, FailureKernels, FailureModel, KernelContact, SceneBatch
+
+
+def no_force_change(contact: KernelContact) -> tuple[float, float]:
+    """An intact plate's force is the intact force: no change [N]."""
+    return 0.0, 0.0
+
+
+def never_perforated(contact: KernelContact) -> float:
+    """An intact plate is never perforated: −inf [m]."""
+    return -np.inf
+
+
+#: The functions of numbers a compiled path compiles.
+KERNELS = (no_force_change, never_perforated)
 
 
 @final
@@ -23,6 +37,7 @@ class Intact(FailureModel):
 
     name = "intact"
     events = ()
+    kernels = FailureKernels(no_force_change, never_perforated)
 
     def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:
         return np.full(scenes.size, np.inf)

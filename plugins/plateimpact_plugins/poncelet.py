@@ -20,6 +20,15 @@ def poncelet_stress(speed: Any, incidence: Any, a: Any, b: Any) -> Any:
     return a + b * normal_speed * normal_speed
 
 
+def poncelet_stress_kernel(speed: float, incidence: float, constants: Any) -> float:
+    """:func:`poncelet_stress` for the compiled path: ``constants`` is a scene's (a, b)."""
+    return poncelet_stress(speed, incidence, constants[0], constants[1])
+
+
+#: The functions of numbers a compiled path compiles (callees before callers).
+KERNELS = (poncelet_stress, poncelet_stress_kernel)
+
+
 @final
 @attrs.frozen
 class Poncelet(ResistanceLaw):
@@ -31,6 +40,8 @@ class Poncelet(ResistanceLaw):
 
     name = "poncelet"
     plate_constants = (STRENGTH_A, DENSITY_B)
+    kernel_columns = ("a", "b")
+    stress_kernel = poncelet_stress_kernel
 
     def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
         return poncelet_stress(speed, incidence, scenes.a, scenes.b)

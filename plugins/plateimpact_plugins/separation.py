@@ -3,32 +3,24 @@
 from __future__ import annotations
 
 from abc import abstractmethod
-from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
 
-from plateimpact import Column, Contact, FailureModel, Parameter, SceneBatch, geometry
+from plateimpact import (
+    Column,
+    Contact,
+    FailureKernels,
+    FailureModel,
+    KernelContact,
+    Parameter,
+    SceneBatch,
+    geometry,
+    kernels,
+)
 
 from .report.constants import FAILURE_ANGLE
 from .report.plane import failure_plane_depth
-
-
-def plane_relief(
-    force: Callable[..., tuple[Any, Any]],
-    force_args: tuple[Any, ...],
-    penetration: Any,
-    obliquity: Any,
-    speed: Any,
-    plane_depth: Any,
-) -> tuple[Any, Any]:
-    """−F′ as (drag, lift) [N] (eq 15): the force ``force(P − h, θ, V, *force_args)`` of
-    the resistance law on the contact surface below the failure plane at depth
-    ``plane_depth`` h [m] (eqs 9–14), no longer exerted; P [m], θ [rad], V [m/s]. On
-    arrays (``force``: the law's ``contact_force``) and on numbers (a compiled
-    ``force_on_contact``) alike."""
-    relieved_drag, relieved_lift = force(penetration - plane_depth, obliquity, speed, *force_args)
-    return -relieved_drag, -relieved_lift
 
 
 def plane_perforation_margin(
@@ -49,8 +41,38 @@ def plane_branch_surfaces(
     return geometry.branch_surfaces(penetration - plane_depth, obliquity, radius)
 
 
+def separation_force_change(contact: KernelContact) -> tuple[float, float]:
+    """:meth:`PlaneSeparation.force_change` of one scene (``contact.constants[0]``: h)."""
+    depth = contact.constants[0]
+    relieved_drag, relieved_lift = kernels.law_force(
+        contact.penetration - depth, contact.obliquity, contact.speed, contact
+    )
+    return -relieved_drag, -relieved_lift
+
+
+def separation_perforation_margin(contact: KernelContact) -> float:
+    """:meth:`PlaneSeparation.perforation_margin` of one scene [m]."""
+    return plane_perforation_margin(
+        contact.penetration, contact.obliquity, contact.radius, contact.constants[0]
+    )
+
+
+def separation_branch_margins(contact: KernelContact, out: Any) -> None:
+    """:meth:`PlaneSeparation.branch_margins` of one scene, into ``out[0:2]`` [m]."""
+    out[0], out[1] = plane_branch_surfaces(
+        contact.penetration, contact.obliquity, contact.radius, contact.constants[0]
+    )
+
+
 #: The functions of numbers a compiled path compiles (besides the core's geometry).
-KERNELS = (failure_plane_depth, plane_relief, plane_perforation_margin, plane_branch_surfaces)
+KERNELS = (
+    failure_plane_depth,
+    plane_perforation_margin,
+    plane_branch_surfaces,
+    separation_force_change,
+    separation_perforation_margin,
+    separation_branch_margins,
+)
 
 
 class PlaneSeparation(FailureModel):
@@ -75,6 +97,13 @@ class PlaneSeparation(FailureModel):
     columns: ClassVar[tuple[Column, ...]] = (
         Column("failure_plane_depth", "m", "depth h of the failure plane (eq 8)"),
     )
+    kernel_columns: ClassVar[tuple[str, ...]] = ("failure_plane_depth",)
+    kernels: ClassVar[FailureKernels | None] = FailureKernels(
+        separation_force_change,
+        separation_perforation_margin,
+        branch_rows=2,
+        branch_margins=separation_branch_margins,
+    )
 
     @abstractmethod
     def onset_penetration(self, scenes: SceneBatch) -> np.ndarray: ...
@@ -86,14 +115,13 @@ class PlaneSeparation(FailureModel):
 
     def relief(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""
-        return plane_relief(
-            contact.law.contact_force,
-            (),
-            contact.penetration,
-            contact.obliquity,
-            contact.speed,
-            contact.scenes.failure_plane_depth,
+        # F′: the law on the contact surface below the plane, eqs 2–6 with P − h for P
+        # (the kernel twin: separation_force_change)
+        depth = contact.scenes.failure_plane_depth
+        relieved_drag, relieved_lift = contact.law.contact_force(
+            contact.penetration - depth, contact.obliquity, contact.speed
         )
+        return -relieved_drag, -relieved_lift  # eq 15
 
     def force_change(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         return self.relief(contact)

@@ -85,6 +85,10 @@ class PlateImpactWarning(UserWarning):
     ``plateimpact: warning: ...``."""
 
 
+class CompiledPathWarning(PlateImpactWarning):
+    """The compiled path could not run (numba missing or failing): the numpy path ran."""
+
+
 class PluginLoadWarning(PlateImpactWarning):
     """An installed plug-in package failed to load and was skipped; the message names
     the distribution, the entry point and the error. Filter it like any warning

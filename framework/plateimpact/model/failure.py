@@ -9,6 +9,7 @@ import numpy as np
 
 from .batch import SceneBatch
 from .events import FAILURE_EVENTS, Event
+from .kernels import FailureKernels
 from .plugin import Plugin
 from .resistance import BoundResistance
 
@@ -77,6 +78,9 @@ class FailureModel(Plugin, ABC):
     state_names: ClassVar[tuple[str, ...]] = ()
     #: Their units, for archives (e.g. ``("rad",)``).
     state_units: ClassVar[tuple[str, ...]] = ()
+    #: The same methods for numbers, for the compiled path (None: this model runs on
+    #: the numpy path only; :mod:`plateimpact.model.kernels`).
+    kernels: ClassVar[FailureKernels | None] = None
 
     @abstractmethod
     def onset_penetration(self, scenes: SceneBatch) -> np.ndarray:

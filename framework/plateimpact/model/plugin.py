@@ -47,12 +47,16 @@ class Plugin:
         object, e.g. ``plateimpact_plugins.STRENGTH_A``).
     columns : tuple of Column
         The per-scene columns its :meth:`prepare` returns.
+    kernel_columns : tuple of str
+        The columns of its view its compiled kernels read, in order (its row of
+        :meth:`kernel_constants`; :mod:`plateimpact.model.kernels`).
     """
 
     name: ClassVar[str]
     version: ClassVar[str] = "1"
     plate_constants: ClassVar[tuple[Parameter, ...]] = ()
     columns: ClassVar[tuple[Column, ...]] = ()
+    kernel_columns: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
     def setting_declarations(cls) -> dict[str, Parameter]:
@@ -71,3 +75,13 @@ class Plugin:
         """The per-scene columns declared in ``columns``, by name, computed once per batch
         before any step from this plug-in's view of the scenes (default: none)."""
         return {}
+
+    def kernel_constants(self, scenes: SceneBatch) -> np.ndarray:
+        """What its compiled kernels read per scene, shape (k, n) [SI]: by default the
+        columns ``kernel_columns`` names, from this plug-in's view of the scenes; a
+        plug-in whose kernels also read settings adds them as rows."""
+        size = scenes.size
+        rows = [np.broadcast_to(getattr(scenes, name), (size,)) for name in self.kernel_columns]
+        if not rows:
+            return np.zeros((0, scenes.size))
+        return np.ascontiguousarray(np.stack(rows), dtype=float)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -25,7 +25,14 @@ class ResistanceLaw(Plugin, ABC):
     a ``plateimpact_register`` hook (:mod:`plateimpact.registry.hookspecs`). Settings are attrs
     fields. ``stress`` runs inside the step loop: numpy only, no Python loop over
     scenes, no hook calls.
+
+    To run on the compiled path too, set ``stress_kernel`` to the same formula for
+    numbers, ``stress(speed [m/s], incidence [rad], constants) -> σ [N/m²]``, reading the
+    columns named in ``kernel_columns`` from ``constants`` (:mod:`plateimpact.model.kernels`).
     """
+
+    #: The compiled path's stress (None: this law runs on the numpy path only).
+    stress_kernel: ClassVar[Callable[..., Any] | None] = None
 
     @abstractmethod
     def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
@@ -123,3 +130,7 @@ class BoundResistance:
         the sphere's deepest point, at ``obliquity`` θ [rad] and ``speed`` V [m/s]
         (:func:`contact_force`)."""
         return contact_force(self.law, penetration, obliquity, speed, self.batch)
+
+
+#: The functions of numbers a compiled path compiles.
+KERNELS = (force_on_contact,)

@@ -17,7 +17,7 @@ from ..model.impact import REST_SPEED_FRACTION, ImpactModel, describe_plugin
 from ..model.results import BatchResult, Result
 from ..model.scene import Scene
 from ..registry.plugin_registry import PluginRegistry, default_registry
-from ..solve.driver import integrate
+from ..solve.driver import ENGINES, choose_engine, integrate
 from ..solve.integrator import Integrator
 from .progress import report_scenes
 
@@ -30,6 +30,12 @@ DEFAULT_CHUNK_SIZE = 2500
 def _integrator(instance: object, attribute: attrs.Attribute, value: object) -> None:
     if not isinstance(value, Integrator):
         raise PluginError(f"integrator must be an Integrator, got {value!r}")
+
+
+def _engine(instance: object, attribute: attrs.Attribute, value: object) -> None:
+    if value not in ENGINES:
+        allowed = ", ".join(ENGINES)
+        raise ParameterError("engine", f"engine must be one of {allowed}, got {value!r:.40}")
 
 
 def _registry(instance: object, attribute: attrs.Attribute, value: object) -> None:
@@ -53,6 +59,9 @@ class Simulation:
 
     model: ImpactModel
     integrator: Integrator = attrs.field(validator=_integrator)
+    #: "auto" (default), "compiled" or "numpy" (:data:`~plateimpact.solve.driver.ENGINES`):
+    #: how runs are integrated; the two paths agree to rounding (docs/integrators.md).
+    engine: str = attrs.field(default="auto", kw_only=True, validator=_engine)
     registry: PluginRegistry = attrs.field(
         factory=default_registry, kw_only=True, eq=False, repr=False, validator=_registry
     )
@@ -69,9 +78,11 @@ class Simulation:
         integrator_settings: Mapping[str, Any] | None = None,
         rest_speed_fraction: float = REST_SPEED_FRACTION.default,  # type: ignore[assignment]
         registry: PluginRegistry | None = None,
+        engine: str = "auto",
     ) -> Simulation:
         """Resolve each slot by name from ``registry`` (default: installed plug-ins); a
-        slot not named takes the registry's default plug-in of its kind."""
+        slot not named takes the registry's default plug-in of its kind. ``engine``: see
+        :attr:`engine`."""
         registry = default_registry() if registry is None else registry
         if not isinstance(registry, PluginRegistry):
             raise ParameterError("registry", f"registry must be a PluginRegistry, got {registry!r}")
@@ -93,7 +104,8 @@ class Simulation:
             rest_speed_fraction=rest_speed_fraction,
         )
         settings = _settings("integrator", integrator_settings)
-        return cls(model, registry.create("integrator", integrator, **settings), registry=registry)
+        created = registry.create("integrator", integrator, **settings)
+        return cls(model, created, registry=registry, engine=engine)
 
     def run_batch(
         self,
@@ -164,6 +176,11 @@ def run_in_chunks(
     A scene's result does not depend on its chunk: chunking changes only the wall time
     and how often ``advance`` is called."""
     parts = []
+    # one engine for the whole run, from its size: a scene's result never depends on
+    # how the run was chunked
+    model, integrator = simulation.model, simulation.integrator
+    trajectories = record_trajectory or craters
+    engine = choose_engine(simulation.engine, model, integrator, bound.size, trajectories)
     chunks = (
         bound.take(np.arange(lo, min(lo + chunk_size, bound.size)))
         if chunk_size < bound.size
@@ -172,11 +189,14 @@ def run_in_chunks(
     )
     if executor is None:
         for chunk in chunks:
-            parts.append(run_chunk(simulation, chunk, record_trajectory, craters))
+            parts.append(run_chunk(simulation, chunk, record_trajectory, craters, engine))
             advance(chunk.size)
     else:
         futures = [
-            (executor.submit(run_chunk, simulation, chunk, record_trajectory, craters), chunk.size)
+            (
+                executor.submit(run_chunk, simulation, chunk, record_trajectory, craters, engine),
+                chunk.size,
+            )
             for chunk in chunks
         ]
         for future, size in futures:
@@ -186,7 +206,11 @@ def run_in_chunks(
 
 
 def run_chunk(
-    simulation: Simulation, bound: BoundBatch, record_trajectory: bool, craters: bool = False
+    simulation: Simulation,
+    bound: BoundBatch,
+    record_trajectory: bool,
+    craters: bool = False,
+    engine: str | None = None,
 ) -> BatchResult:
     """One chunk of a run, in an executor's worker (picklable: a module function);
     crater sections, when asked for, are computed there too."""
@@ -195,6 +219,7 @@ def run_chunk(
         simulation.integrator,
         bound,
         record_trajectory=record_trajectory or craters,
+        engine=simulation.engine if engine is None else engine,
     )
     if craters:
         result.craters = crater_sections(result, bound.core.radius, bound.core.thickness)

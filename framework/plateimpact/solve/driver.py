@@ -11,20 +11,73 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 
 import numpy as np
 
-from ..base.errors import IntegrationError
+from ..base.errors import CompiledPathWarning, ParameterError
 from ..model.batch import SceneBatch
 from ..model.binding import BoundBatch
 from ..model.events import EVENT_OUTCOMES, EVENTS, ONSET, RESTARTING, TURNED_BACK
 from ..model.impact import KINEMATIC_STATE, LATERAL, OBLIQUITY, PENETRATION, SPEED, ImpactModel
 from ..model.results import BatchResult, Outcome
+from .bounds import unfinished_error
 from .control import StepSizes
 from .dynamics import Dynamics
 from .event_location import first_event, sample_step
 from .integrator import Integrator, StepperState
 from .recorder import ResultRecorder
+
+#: How a batch is integrated: "compiled" (numba; :mod:`plateimpact.solve.compiled`),
+#: "numpy" (this module's loop), or "auto": compiled wherever the plug-ins provide
+#: kernels and the run has at least COMPILED_MIN_SCENES scenes.
+ENGINES = ("auto", "compiled", "numpy")
+#: Below this many scenes "auto" keeps a run on the numpy path: loading the compiled
+#: program (numba's import and its cache, about half a second) would cost more than the
+#: run (100 µs a scene on the numpy path). Decided per run, never per chunk, so that a
+#: scene's result never depends on how its run was chunked.
+COMPILED_MIN_SCENES = 2000
+
+_warned: set[str] = set()
+
+
+def choose_engine(
+    requested: str, model: ImpactModel, integrator: Integrator, size: int, trajectories: bool
+) -> str:
+    """The engine a run of ``size`` scenes uses: "compiled" or "numpy". Under "auto",
+    a run the compiled path cannot take (trajectories asked for, plug-ins without
+    kernels, numba missing) runs on the numpy path; numba missing is said in one
+    warning line per process."""
+    if requested == "numpy" or (requested == "auto" and size < COMPILED_MIN_SCENES):
+        return "numpy"
+    from .compiled.engine import unavailable_reason  # noqa: PLC0415
+
+    reason = unavailable_reason(model, integrator)
+    if reason is None and trajectories:
+        reason = "trajectories are recorded on the numpy path"
+    if reason is None:
+        try:
+            import numba  # noqa: F401, PLC0415
+        except ImportError:
+            reason = "numba is not installed (pip install 'plateimpact[fast]')"
+            if requested == "auto":
+                warn_once(reason)
+    if reason is None:
+        return "compiled"
+    if requested == "compiled":
+        raise ParameterError("engine", f"engine 'compiled' cannot run this model: {reason}")
+    return "numpy"
+
+
+def warn_once(reason: str) -> None:
+    """Say once per process why the compiled path did not run."""
+    if reason not in _warned:
+        _warned.add(reason)
+        warnings.warn(
+            f"compiled path unavailable: {reason}; running on the numpy path",
+            CompiledPathWarning,
+            stacklevel=3,
+        )
 
 
 def integrate(
@@ -33,35 +86,41 @@ def integrate(
     batch: SceneBatch | BoundBatch,
     *,
     record_trajectory: bool = False,
+    engine: str = "auto",
 ) -> BatchResult:
     """Integrate every scene of ``batch`` from first contact, (P, Y, θ, V) = (0, 0, θs,
     Vs), to its outcome. A :class:`BoundBatch` (``model.bind``, or a part of one) is
-    used as it is, so that a run bound once can be integrated in parts."""
+    used as it is, so that a run bound once can be integrated in parts. ``engine``: one
+    of :data:`ENGINES` (:func:`choose_engine` on this batch's size under "auto")."""
     recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
     if batch.size:
         bound = batch if isinstance(batch, BoundBatch) else model.bind(batch)
-        _integrate(model, integrator, bound, recorder)
+        chosen = choose_engine(engine, model, integrator, bound.size, record_trajectory)
+        if chosen == "compiled" and _integrate_compiled(model, integrator, bound, recorder):
+            recorder.stats["compiled_scenes"] = bound.size
+        else:
+            _integrate(model, integrator, bound, recorder)
     return recorder.result()
+
+
+def _integrate_compiled(
+    model: ImpactModel, integrator: Integrator, batch: BoundBatch, recorder: ResultRecorder
+) -> bool:
+    """The batch on the compiled path; False (and one warning line) where the program
+    could not be built or compiled, so that the numpy path runs it instead."""
+    from .compiled.engine import ProgramUnavailable, integrate_compiled  # noqa: PLC0415
+
+    try:
+        integrate_compiled(model, integrator, batch, recorder)
+    except ProgramUnavailable as exc:
+        warn_once(str(exc))
+        return False
+    return True
 
 
 def _select(accepted: np.ndarray, new: StepperState, old: StepperState) -> StepperState:
     """The carried state: the new one where the step was accepted."""
     return {key: np.where(accepted, new[key], old[key]) for key in old}
-
-
-def _unfinished(
-    integrator: Integrator, limit: str, setting: str, example: str, scene: np.ndarray, where: str
-) -> IntegrationError:
-    """The one-line error of a scene that exhausted a work bound: how far it got, and the
-    setting to raise (on the command line too, where the integrator declares it)."""
-    if setting in integrator.setting_declarations():
-        change = f"raise {setting} (--set integrator.{setting}={example})"
-    else:
-        change = f"raise the integrator's {setting}"
-    return IntegrationError(
-        f"{integrator.name}: {scene.size} scene(s) unfinished after {limit} (first: scene "
-        f"{int(scene[0])}, {where}); {change}"
-    )
 
 
 class _WallTime:
@@ -125,7 +184,7 @@ def _integrate(
         if clock is not None and limit is not None and clock.charge(scene.size) > limit:
             where = _progress(y, t, batch, stats)
             text = f"max_seconds={limit:g} s of wall time"
-            raise _unfinished(integrator, text, "max_seconds", "SECONDS", scene, where)
+            raise unfinished_error(integrator, text, "max_seconds", "SECONDS", scene, where)
         stats["steps"] += 1
         step = integrator.advance(dynamics, t, y, sizes.propose(dynamics, y, state), state)
         ok = sizes.judge(step, y, dynamics)
@@ -225,4 +284,4 @@ def _integrate(
             dynamics = Dynamics(model, batch, failed, held, stats)
     where = _progress(y, t, batch, stats)
     text = f"max_steps={integrator.max_steps} steps"
-    raise _unfinished(integrator, text, "max_steps", "N", scene, where)
+    raise unfinished_error(integrator, text, "max_steps", "N", scene, where)

@@ -80,6 +80,21 @@ class StepControl(NamedTuple):
     branch_landing: bool = True
 
 
+class PairTableau(NamedTuple):
+    """An explicit embedded Runge–Kutta pair with first-same-as-last stage and polynomial
+    dense output, as data: ``C`` (s,), ``A`` (s, s), ``B`` (s,), the error weights ``E``
+    (s + 1,: the last for the FSAL stage), the dense-output matrix ``P`` (s + 1, Q:
+    coefficients of σ, σ², ...) and ``error_order`` (the step follows
+    err^(−1/error_order)). What the compiled path integrates with."""
+
+    C: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    E: np.ndarray
+    P: np.ndarray
+    error_order: int
+
+
 class Step(NamedTuple):
     """One step of every active scene.
 
@@ -135,6 +150,12 @@ class Integrator(Plugin, ABC):
         self, dynamics: Dynamics, t: np.ndarray, y: np.ndarray, h: np.ndarray, state: StepperState
     ) -> Step:
         """One step of length ``h`` [s] of every scene from (t, y)."""
+
+    def compiled_tableau(self) -> PairTableau | None:
+        """The pair this integrator steps with, if it is an embedded Runge–Kutta pair with
+        error control that the compiled path can run in its place, taking the same steps
+        (:mod:`plateimpact.solve.compiled`); None (default): the numpy path only."""
+        return None
 
     def known_rates(self, state: StepperState) -> np.ndarray | None:
         """dy/dt at the current state, shape (d, n), if the carried ``state`` holds it (a

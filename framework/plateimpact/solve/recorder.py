@@ -33,6 +33,7 @@ class ResultRecorder:
             "force_evaluations": 0,
             "accepted_steps": 0,
             "rejected_steps": 0,
+            "compiled_scenes": 0,
         }
 
     def sample(

@@ -19,7 +19,7 @@ contract (docs/plugins.md, where each is shown), declared here and registered th
 
 from __future__ import annotations
 
-from typing import final
+from typing import Any, final
 
 import attrs
 import numpy as np
@@ -64,16 +64,28 @@ class RatePoncelet(ResistanceLaw):
         return strength + scenes.b * normal_speed * normal_speed
 
 
+def isotropic_stress(speed: Any, incidence: Any, constants: Any) -> Any:
+    """σ = a + b V² [N/m²] at speed V [m/s], whatever the incidence ψ [rad]; constants
+    (a [N/m²], b [kg/m³]): the formula once, for arrays and for numbers."""
+    return constants[0] + constants[1] * speed * speed
+
+
+#: The functions of numbers the compiled path compiles.
+KERNELS = (isotropic_stress,)
+
+
 @final
 @attrs.frozen
 class IsotropicPoncelet(ResistanceLaw):
-    """σ = a + b V² [N/m²]."""
+    """σ = a + b V² [N/m²], on the compiled path too."""
 
     name = "isotropic-poncelet"
     plate_constants = (STRENGTH_A, DENSITY_B)
+    kernel_columns = ("a", "b")  # a scene's constants, in this order
+    stress_kernel = isotropic_stress
 
     def stress(self, speed: np.ndarray, incidence: np.ndarray, scenes: SceneBatch) -> np.ndarray:
-        return scenes.a + scenes.b * speed * speed
+        return isotropic_stress(speed, incidence, (scenes.a, scenes.b))
 
 
 @hookimpl

@@ -1,0 +1,173 @@
+"""A batch on the compiled path: the pair's program run over the scenes in parallel, its
+per-scene results gathered as the numpy driver records them."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+
+from ...base.errors import PluginError
+from ...model.binding import BoundBatch
+from ...model.events import EVENTS, FAILURE_ONSET, PERFORATION
+from ...model.impact import KINEMATIC_STATE, OBLIQUITY, SPEED, ImpactModel
+from ...model.results import Outcome
+from ..bounds import unfinished_error
+from ..control import MAX_STEP
+from ..dynamics import Dynamics
+from ..integrator import Integrator
+from ..recorder import ResultRecorder
+from . import program, scene
+
+#: Scenes handed to a thread at a time: small enough to balance scenes of very different
+#: cost (a map's slow perforations beside its quick ricochets) over the cores, large
+#: enough that handing them out (some microseconds) costs nothing.
+PARALLEL_CHUNK = 64
+_threads: list[int] = [0]  # 0: one per core
+
+
+def set_threads(count: int) -> None:
+    """Run the compiled path on ``count`` threads (0: one per core)."""
+    _threads[0] = count
+
+
+def threads() -> int:
+    """The threads the compiled path runs on."""
+    return _threads[0] or os.cpu_count() or 1
+
+
+def run_parallel(run: Callable[..., None], n: int, arguments: tuple[Any, ...]) -> None:
+    """``run(start, stop, *arguments)`` over scenes 0 .. n − 1 in chunks, on the threads
+    (the compiled loop releases the GIL). A scene's result does not depend on its chunk
+    or thread: each writes only its own rows."""
+    chunks = [(lo, min(lo + PARALLEL_CHUNK, n)) for lo in range(0, n, PARALLEL_CHUNK)]
+    workers = min(threads(), len(chunks))
+    if workers <= 1:
+        run(0, n, *arguments)
+        return
+    with ThreadPoolExecutor(workers) as pool:
+        for future in [pool.submit(run, lo, hi, *arguments) for lo, hi in chunks]:
+            future.result()
+
+
+class ProgramUnavailable(Exception):
+    """The pair's program could not be built, loaded or compiled: the reason, one line."""
+
+
+def unavailable_reason(model: ImpactModel, integrator: Integrator) -> str | None:
+    """Why this model and integrator cannot run compiled (None: they can)."""
+    if type(model.resistance).stress_kernel is None:
+        return f"resistance {model.resistance.name!r} provides no compiled kernel"
+    if type(model.failure).kernels is None:
+        return f"failure {model.failure.name!r} provides no compiled kernels"
+    if integrator.compiled_tableau() is None or integrator.step_control() is None:
+        return f"integrator {integrator.name!r} is not an adaptive embedded Runge-Kutta pair"
+    if integrator.max_seconds is not None and np.isfinite(integrator.max_seconds):
+        return "a wall-time bound (max_seconds) is set"
+    return None
+
+
+def integrate_compiled(
+    model: ImpactModel, integrator: Integrator, batch: BoundBatch, recorder: ResultRecorder
+) -> None:
+    """Integrate every scene of ``batch`` on the compiled path into ``recorder``
+    (results as :func:`~plateimpact.solve.driver.integrate` records them; trajectories
+    are the numpy path's)."""
+    pair = integrator.compiled_tableau()
+    control = integrator.step_control()
+    assert pair is not None and control is not None
+    try:
+        compiled = program.program(model.resistance, model.failure)
+    except (ImportError, OSError, PluginError) as exc:
+        raise ProgramUnavailable(f"{type(exc).__name__}: {exc}") from exc
+    n = batch.size
+    width = KINEMATIC_STATE + len(model.failure.state_names)
+    failure_kernels = type(model.failure).kernels
+    assert failure_kernels is not None
+    stats = recorder.stats
+    dynamics = Dynamics(model, batch, np.zeros(n, bool), np.zeros(n, bool), stats)
+    core = batch.core
+    columns = (core.radius, core.mass, core.rest_speed, core.onset_penetration)
+    first = integrator.initial_step(dynamics)
+    table = np.ascontiguousarray(np.stack([*columns, first, dynamics.time_scale]).T)
+    y = np.zeros((n, width))
+    y[:, OBLIQUITY], y[:, SPEED] = core.impact_obliquity, core.impact_speed
+    y[:, KINEMATIC_STATE:] = model.new_failure_state(n).T
+    scale = np.ascontiguousarray(dynamics.component_scale(width).T)
+    constants = np.ascontiguousarray(model.failure.kernel_constants(batch.failure).T, float)
+    law_constants = np.ascontiguousarray(model.resistance.kernel_constants(batch.resistance).T)
+    turn_back = ImpactModel.MAX_OBLIQUITY - ImpactModel.TURN_BACK_TOLERANCE
+    floats = np.array(
+        [pair.error_order, control.rtol, MAX_STEP, ImpactModel.MAX_OBLIQUITY, turn_back]
+    )
+    adds = [event in model.failure.events for event in (FAILURE_ONSET, PERFORATION)]
+    ints = np.array(
+        [control.branch_landing, *adds, integrator.max_steps,
+         2 + failure_kernels.branch_rows, Outcome.EMBEDMENT],
+        dtype=np.int64,
+    )  # fmt: skip
+    outcomes = np.array([0 if e.outcome is None else int(e.outcome) for e in EVENTS], np.int64)
+    restarts = np.array([e.restarts for e in EVENTS])
+    results = np.full((n, scene.FLOAT_RESULTS), np.nan)
+    counts = np.zeros((n, scene.COUNTS), np.int64)
+    arguments = (
+        table, y, scale, constants, law_constants,
+        *(np.ascontiguousarray(part, float) for part in pair[:5]),
+        floats, ints, outcomes, restarts, results, counts,
+    )  # fmt: skip
+    try:
+        compiled.run(0, 0, *arguments)  # compiles, or loads numba's cache, here
+    except Exception as exc:  # numba's errors: the numpy path runs instead
+        said = str(exc).strip().splitlines()
+        raise ProgramUnavailable(
+            f"compiling failed ({type(exc).__name__}: {said[0] if said else ''})"
+        ) from exc
+    run_parallel(compiled.run, n, arguments)
+    _record(recorder, results, counts, batch, integrator)
+
+
+def _record(
+    recorder: ResultRecorder,
+    results: np.ndarray,
+    counts: np.ndarray,
+    batch: BoundBatch,
+    integrator: Integrator,
+) -> None:
+    stats = recorder.stats
+    stats["steps"] += int(counts[:, scene.STEPS].max(initial=0))
+    stats["accepted_steps"] += int(counts[:, scene.ACCEPTED].sum())
+    stats["rejected_steps"] += int(counts[:, scene.REJECTED].sum())
+    stats["force_evaluations"] += int(counts[:, scene.FORCE_EVALUATIONS].sum())
+    outcome = counts[:, scene.OUTCOME]
+    unfinished = np.flatnonzero(outcome == 0)
+    if unfinished.size:
+        first = unfinished[0]
+        radius, speed = batch.core.radius[first], batch.core.impact_speed[first]
+        where = (
+            f"at P = {results[first, scene.LAST_PENETRATION] / radius:.3g} Rs, "
+            f"V = {results[first, scene.LAST_SPEED] / speed:.3g} Vs, "
+            f"t = {results[first, scene.LAST_TIME] * speed / radius:.3g} Rs/Vs after "
+            f"{stats['steps']} steps"
+        )
+        text = f"max_steps={integrator.max_steps} steps"
+        raise unfinished_error(integrator, text, "max_steps", "N", unfinished, where)
+    failed = counts[:, scene.PLATE_FAILED] == 1
+    index = np.flatnonzero(failed)
+    recorder.failed(
+        index,
+        results[index, scene.FAILURE_TIME],
+        results[index, scene.FAILURE_PENETRATION],
+        results[index, scene.FAILURE_LATERAL],
+    )
+    everyone = np.arange(outcome.size)
+    recorder.finish(
+        everyone,
+        outcome.astype(np.int8),
+        results[:, scene.EXIT_SPEED],
+        results[:, scene.EXIT_OBLIQUITY],
+        results[:, scene.CONTACT_TIME],
+        results[:, scene.MAX_PENETRATION],
+    )

@@ -1,0 +1,124 @@
+"""One scene's right-hand side and margins, as numbers: the compiled twin of
+:meth:`ImpactModel.rates <plateimpact.model.impact.ImpactModel.rates>`,
+``event_margins`` and ``branch_margins``, calling the same formulas (eqs 1-6, 15-30).
+
+``model`` is a :class:`CompiledModel` (the plug-ins' kernels), ``scene`` a
+:class:`SceneConstants`; ``y`` the state P [m], Y [m], θ [rad], V [m/s], then the failure
+state. Results are written into ``out`` (no allocation in the step loop).
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ...model.events import AT_REST, CONTACT_LOST, ONSET, PERFORATED, TURNED_BACK
+from ...model.geometry import HALF_PI, branch_surfaces, contact_geometry_kernel, contact_lost_margin
+from ...model.kernels import KernelContact
+from ...model.resistance import force_on_contact
+
+P_, Y_, THETA_, V_ = 0, 1, 2, 3  # rows of y (plateimpact.model.impact.PENETRATION ...)
+STATE = 4  # first failure-state row (KINEMATIC_STATE)
+
+
+class CompiledModel(NamedTuple):
+    """The plug-ins' kernels: the law's stress, the failure model's :class:`FailureKernels`."""
+
+    stress: Any
+    force_change: Any
+    perforation_margin: Any
+    branch_margins: Any
+    initial_state: Any
+    state_rates: Any
+
+
+class SceneConstants(NamedTuple):
+    """One scene's constants: Rs [m], m [kg], the rest speed [m/s], the onset penetration
+    [m], θ held at turn-back [rad] and the limit that counts as turned back [rad], whether
+    the failure model adds onset and perforation, and the two plug-ins' kernel rows."""
+
+    radius: float
+    mass: float
+    rest_speed: float
+    onset_penetration: float
+    max_obliquity: float
+    turn_back_limit: float
+    adds_onset: bool
+    adds_perforation: bool
+    constants: Any
+    law_constants: Any
+
+
+def contact_of(
+    model: CompiledModel, scene: SceneConstants, y: Any, obliquity: float, obliquity_rate: float
+) -> KernelContact:
+    """The failure model's view of the scene at ``y``, at ``obliquity`` θ >= 0 [rad]."""
+    return KernelContact(
+        y[P_], obliquity, y[V_], obliquity_rate, y[STATE:], scene.constants, scene.radius,
+        model.stress, scene.law_constants,
+    )  # fmt: skip
+
+
+def rates(
+    model: CompiledModel, scene: SceneConstants, y: Any, failed: bool, held: bool, out: Any
+) -> None:
+    """dy/dt into ``out`` (:meth:`ImpactModel.rates`): θ < 0 is the mirror image of |θ|."""
+    theta, speed = y[THETA_], y[V_]
+    side = -1.0 if theta < 0.0 else 1.0
+    obliquity = np.abs(theta)
+    drag, lift = force_on_contact(
+        y[P_], obliquity, speed, scene.radius, contact_geometry_kernel, model.stress,
+        (scene.law_constants,),
+    )  # fmt: skip
+    if failed:
+        extra_drag, extra_lift = model.force_change(contact_of(model, scene, y, obliquity, np.nan))
+        drag, lift = drag + extra_drag, lift + extra_lift
+    lift = side * lift
+    obliquity_rate = 0.0 if held else lift / (scene.mass * speed)
+    out[P_] = speed * np.cos(theta)
+    out[Y_] = speed * np.sin(theta)
+    out[THETA_] = obliquity_rate
+    out[V_] = -drag / scene.mass
+    if failed:
+        contact = contact_of(model, scene, y, side * theta, side * obliquity_rate)
+        model.state_rates(contact, out[STATE:])
+    else:
+        for row in range(STATE, y.size):
+            out[row] = 0.0
+
+
+def event_margins(
+    model: CompiledModel, scene: SceneConstants, y: Any, failed: bool, held: bool, out: Any
+) -> None:
+    """The event margins into ``out`` (:meth:`ImpactModel.event_margins`, every row)."""
+    penetration, obliquity = y[P_], np.abs(y[THETA_])
+    if scene.adds_onset and not failed:
+        out[ONSET] = penetration - scene.onset_penetration
+    else:
+        out[ONSET] = -np.inf
+    out[CONTACT_LOST] = contact_lost_margin(penetration, obliquity, scene.radius)
+    if scene.adds_perforation and failed and obliquity < HALF_PI:
+        out[PERFORATED] = model.perforation_margin(contact_of(model, scene, y, obliquity, np.nan))
+    else:
+        out[PERFORATED] = -np.inf
+    out[AT_REST] = scene.rest_speed - y[V_]
+    out[TURNED_BACK] = -np.inf if held else obliquity - scene.turn_back_limit
+
+
+def branch_margins(
+    model: CompiledModel, scene: SceneConstants, y: Any, failed: bool, out: Any
+) -> None:
+    """The branch margins into ``out`` (:meth:`ImpactModel.branch_margins`): the
+    geometry's two rows, then the failure model's (NaN while the plate is intact)."""
+    obliquity = np.abs(y[THETA_])
+    out[0], out[1] = branch_surfaces(y[P_], obliquity, scene.radius)
+    if failed:
+        model.branch_margins(contact_of(model, scene, y, obliquity, np.nan), out[2:])
+    else:
+        for row in range(2, out.size):
+            out[row] = np.nan
+
+
+#: The functions of numbers a compiled path compiles (callees before callers).
+KERNELS = (contact_of, rates, event_margins, branch_margins)

@@ -1,0 +1,135 @@
+"""One scene from first contact, (P, Y, θ, V) = (0, 0, θs, Vs), to its outcome: the
+compiled twin of the numpy driver's loop (:mod:`plateimpact.solve.driver`) for one scene,
+with the same steps, events, failure onset, 180° hold, maximum penetration and work
+bound."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...model.events import ONSET, TURNED_BACK
+from .events import EventWork, first_event
+from .motion import P_, STATE, THETA_, V_, Y_, CompiledModel, SceneConstants, event_margins, rates
+from .motion import contact_of as _contact_of
+from .stepping import StepWork, Tableau, advance, dense_coefficients, dense_state, judge, propose
+
+#: Columns of the per-scene float results, and of the counts.
+EXIT_SPEED, EXIT_OBLIQUITY, CONTACT_TIME, MAX_PENETRATION = 0, 1, 2, 3
+FAILURE_TIME, FAILURE_PENETRATION, FAILURE_LATERAL = 4, 5, 6
+LAST_PENETRATION, LAST_SPEED, LAST_TIME = 7, 8, 9
+FLOAT_RESULTS = 10
+OUTCOME, PLATE_FAILED, STEPS, ACCEPTED, REJECTED, FORCE_EVALUATIONS = range(6)
+COUNTS = 6
+
+
+def integrate_scene(
+    model: CompiledModel, scene: SceneConstants, tab: Tableau, y: Any, scale: Any,
+    h_first: float, unit: float, max_steps: int, branch_rows: int, outcomes: Any,
+    restarts: Any, embedment: int, results: Any, counts: Any,
+) -> None:  # fmt: skip
+    """Integrate the scene whose initial state is ``y`` (changed in place) and write its
+    results into ``results`` and ``counts`` (outcome 0: unfinished after ``max_steps``).
+    ``outcomes`` and ``restarts``: each event's outcome code (0: goes on) and whether
+    the right-hand side changes there (from :data:`plateimpact.model.events.EVENTS`)."""
+    d = y.size
+    s = tab.C.size
+    work = StepWork(
+        np.empty((s + 1, d)), np.empty(d), np.empty(d), np.empty(d),
+        np.empty((tab.P.shape[1], d)), np.empty(branch_rows), np.empty(branch_rows),
+        np.zeros(branch_rows, np.bool_),
+    )  # fmt: skip
+    at = np.linspace(0.0, 1.0, 5)
+    events = outcomes.size
+    ev = EventWork(
+        at, np.empty((at.size, d)), np.empty((at.size, events)), np.empty(events),
+        np.empty(d), np.empty(events),
+    )  # fmt: skip
+    known_margins = np.empty(events)
+    known = False
+    failed = held = d < 0  # False, typed as a plain bool (a literal would compile twice)
+    t = 0.0
+    max_penetration = 0.0
+    h_next, just_rejected, forced = h_first, False, False
+    rates(model, scene, y, failed, held, work.stages[0])  # first same as last
+    evaluations = 1
+    accepted = rejected = steps = 0
+    for _ in range(max_steps):
+        steps += 1
+        h, planned, landing = propose(model, scene, tab, work, y, h_next, unit, failed, forced)
+        forced = False
+        advance(model, scene, tab, work, y, h, failed, held)
+        evaluations += s
+        ok, h_next, just_rejected, forced = judge(
+            model, scene, tab, work, y, scale, h, planned, landing, just_rejected, failed
+        )
+        if not ok:
+            rejected += 1
+            continue
+        accepted += 1
+        # Sample the step; find the first event in it.
+        dense_coefficients(tab, work, h)
+        samples, margins = ev.samples, ev.margins
+        samples[0, :], samples[at.size - 1, :] = y, work.y_new
+        for j in range(1, at.size - 1):
+            dense_state(work.coefficients, y, at[j], samples[j])
+        for j in range(at.size):
+            if j == 0 and known:
+                margins[0, :] = known_margins
+            else:
+                event_margins(model, scene, samples[j], failed, held, margins[j])
+        event_sigma, kind, crest_sigma = first_event(
+            model, scene, ev, work.coefficients, y, failed, held
+        )
+        hit = np.isfinite(event_sigma)
+        end_sigma = event_sigma if hit else 1.0
+        # Maximum penetration: at the samples inside the step, its end, and the crest.
+        peak = -np.inf
+        for j in range(at.size):
+            if at[j] <= end_sigma:
+                peak = np.maximum(peak, samples[j, P_])
+        if hit:
+            dense_state(work.coefficients, y, end_sigma, ev.state)
+        else:
+            ev.state[:] = work.y_new
+        peak = np.maximum(peak, ev.state[P_])
+        if crest_sigma < end_sigma:
+            dense_state(work.coefficients, y, crest_sigma, work.trial)
+            peak = np.maximum(peak, work.trial[P_])
+        max_penetration = np.maximum(max_penetration, peak)
+        t = t + end_sigma * h
+        y[:] = ev.state
+        work.stages[0, :] = work.stages[s]  # the carried derivative (FSAL)
+        known_margins[:] = margins[at.size - 1]
+        known = not hit
+        if not hit:
+            continue
+        if kind == ONSET:
+            failed = True
+            if d > STATE:
+                contact = _contact_of(model, scene, y, y[THETA_], np.nan)
+                model.initial_state(contact, y[STATE:])
+            results[FAILURE_TIME], results[FAILURE_PENETRATION] = t, y[P_]
+            results[FAILURE_LATERAL] = y[Y_]
+        if kind == TURNED_BACK:
+            held = True
+            y[THETA_] = scene.max_obliquity
+        if restarts[kind]:  # a new right-hand side from here: the stepper starts afresh
+            rates(model, scene, y, failed, held, work.stages[0])
+            evaluations += 1
+        if outcomes[kind] > 0:
+            results[EXIT_SPEED] = 0.0 if outcomes[kind] == embedment else y[V_]
+            results[EXIT_OBLIQUITY] = np.abs(y[THETA_])
+            results[CONTACT_TIME] = t
+            results[MAX_PENETRATION] = max_penetration
+            counts[OUTCOME] = outcomes[kind]
+            break
+    counts[PLATE_FAILED] = 1 if failed else 0
+    counts[STEPS], counts[ACCEPTED], counts[REJECTED] = steps, accepted, rejected
+    counts[FORCE_EVALUATIONS] = evaluations
+    results[LAST_PENETRATION], results[LAST_SPEED], results[LAST_TIME] = y[P_], y[V_], t
+
+
+#: The functions of numbers a compiled path compiles.
+KERNELS = (integrate_scene,)

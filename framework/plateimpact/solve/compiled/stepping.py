@@ -1,0 +1,189 @@
+"""One scene's step: an explicit embedded Runge–Kutta pair with FSAL and dense output
+(the tableau of :class:`~plateimpact.solve.integrator.Tableau`), its error control and
+its landing on branch surfaces, as numbers: the compiled twin of
+:class:`plateimpact.solve.control.StepSizes` and ``EmbeddedRungeKutta.advance``, in the
+same order of operations (so that the two paths take the same steps).
+
+``work`` is a :class:`StepWork` of one scene's scratch arrays; each function returns the
+new values of what it changes.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ..control import BRANCH_APPROACH, BRANCH_CROSSING, MAX_FACTOR, MIN_FACTOR, SAFETY
+from .motion import CompiledModel, SceneConstants, branch_margins, rates
+
+
+class Tableau(NamedTuple):
+    """C (s,), A (s, s), B (s,), E (s + 1,: the last for the FSAL stage), the dense
+    output P (s + 1, Q), the error order, and the error control: rtol, the largest step
+    [fraction of Rs/Vs], whether steps land on branch surfaces."""
+
+    C: Any
+    A: Any
+    B: Any
+    E: Any
+    P: Any
+    error_order: float
+    rtol: float
+    max_step: float
+    branch_landing: bool
+
+
+class StepWork(NamedTuple):
+    """A scene's scratch arrays: the stages (s + 1, d), the trial and new state, the
+    error, the dense coefficients (Q, d), the branch margins now and at a trial point,
+    and which branch rows the step crosses on purpose."""
+
+    stages: Any
+    trial: Any
+    y_new: Any
+    error: Any
+    coefficients: Any
+    margins: Any
+    ahead: Any
+    crossing: Any
+
+
+def propose(
+    model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, y: Any,
+    h_next: float, unit: float, failed: bool, forced: bool,
+) -> tuple[float, float, bool]:  # fmt: skip
+    """The step to attempt [s], the step it was planned to be, and whether it is
+    shortened to land on a branch surface (``StepSizes.propose`` and
+    ``approach_branches``: the Euler prediction y + h f(y) of the surfaces)."""
+    h = np.minimum(h_next, tab.max_step * unit)
+    if not tab.branch_landing:
+        return h, h, False
+    planned = h
+    derivative = work.stages[0]
+    branch_margins(model, scene, y, failed, work.margins)
+    for k in range(y.size):
+        work.trial[k] = y[k] + h * derivative[k]
+    branch_margins(model, scene, work.trial, failed, work.ahead)
+    fraction = np.inf
+    for r in range(work.margins.size):
+        now, ahead = work.margins[r], work.ahead[r]
+        row_fraction = now / (now - ahead) if now * ahead < 0.0 else np.inf
+        work.crossing[r] = row_fraction < BRANCH_CROSSING
+        fraction = np.minimum(fraction, row_fraction)
+    if forced:  # a surface found just ahead by a refused step: crossed now, as judged
+        for r in range(work.crossing.size):
+            work.crossing[r] = True
+        return h, planned, False
+    if fraction < BRANCH_CROSSING:
+        return BRANCH_CROSSING * h, planned, False
+    if fraction < 1.0:
+        return BRANCH_APPROACH * fraction * h, planned, True
+    return h, planned, False
+
+
+def advance(
+    model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, y: Any,
+    h: float, failed: bool, held: bool,
+) -> None:  # fmt: skip
+    """One step of length ``h`` [s] from ``y`` (stage 0: the carried derivative): the new
+    state, its error estimate and the FSAL stage into ``work``
+    (``EmbeddedRungeKutta.advance``; sums in stage order, zero weights skipped)."""
+    stages, s = work.stages, tab.C.size
+    for i in range(1, s):
+        for k in range(y.size):
+            total = 0.0
+            for j in range(i):
+                if tab.A[i, j] != 0.0:
+                    total += tab.A[i, j] * stages[j, k]
+            work.trial[k] = y[k] + h * total
+        rates(model, scene, work.trial, failed, held, stages[i])
+    for k in range(y.size):
+        total = 0.0
+        for j in range(tab.B.size):
+            if tab.B[j] != 0.0:
+                total += tab.B[j] * stages[j, k]
+        work.y_new[k] = y[k] + h * total
+    rates(model, scene, work.y_new, failed, held, stages[s])
+    for k in range(y.size):
+        total = 0.0
+        for j in range(tab.E.size):
+            if tab.E[j] != 0.0:
+                total += tab.E[j] * stages[j, k]
+        work.error[k] = h * total
+
+
+def judge(
+    model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, y: Any,
+    scale: Any, h: float, planned: float, landing: bool, just_rejected: bool, failed: bool,
+) -> tuple[bool, float, bool, bool]:  # fmt: skip
+    """Whether the step is accepted, the next step [s], whether this one counts as
+    rejected, and whether the next must cross a surface just ahead (``StepSizes.judge``
+    and ``_refuse_unplanned_crossings``)."""
+    finite = True
+    norm = 0.0
+    for k in range(y.size):
+        finite = finite and np.isfinite(work.y_new[k])
+        size = np.maximum(scale[k], np.maximum(np.abs(y[k]), np.abs(work.y_new[k])))
+        ratio = np.abs(work.error[k]) / (tab.rtol * size)
+        norm = ratio if k == 0 else np.maximum(norm, ratio)
+    ok = np.isfinite(norm) and finite and norm <= 1.0
+    factor = np.minimum(
+        np.maximum(SAFETY * np.power(norm, -1.0 / tab.error_order), MIN_FACTOR), MAX_FACTOR
+    )
+    if not np.isfinite(factor):
+        factor = MIN_FACTOR
+    if just_rejected or not ok:
+        factor = np.minimum(factor, 1.0)
+    if tab.branch_landing and landing and ok:  # resume the planned step after landing
+        factor = planned / h
+    h_next = h * factor
+    if not (tab.branch_landing and ok):
+        return ok, h_next, not ok, False
+    # A step that ended across a surface it did not plan to cross is refused and redone
+    # onto it (the margins at its start are in work.margins since propose).
+    branch_margins(model, scene, work.y_new, failed, work.ahead)
+    where = np.inf
+    crossed = False
+    for r in range(work.margins.size):
+        start, end = work.margins[r], work.ahead[r]
+        if start * end < 0.0 and not work.crossing[r]:
+            crossed = True
+            where = np.minimum(where, start / (start - end))
+    if not crossed:
+        return True, h_next, False, False
+    if where < BRANCH_CROSSING:
+        return False, BRANCH_CROSSING * h, True, True
+    return False, BRANCH_APPROACH * where * h, True, False
+
+
+def dense_coefficients(tab: Tableau, work: StepWork, h: float) -> None:
+    """The dense output's polynomial coefficients c_q = h Σ_j P[j, q] k_j, stage by stage
+    (``RungeKuttaDense.polynomial``)."""
+    coefficients = work.coefficients
+    for q in range(coefficients.shape[0]):
+        for k in range(coefficients.shape[1]):
+            coefficients[q, k] = 0.0
+    for j in range(tab.P.shape[0]):
+        for q in range(tab.P.shape[1]):
+            if tab.P[j, q] != 0.0:
+                for k in range(coefficients.shape[1]):
+                    coefficients[q, k] += tab.P[j, q] * work.stages[j, k]
+    for q in range(coefficients.shape[0]):
+        for k in range(coefficients.shape[1]):
+            coefficients[q, k] *= h
+
+
+def dense_state(coefficients: Any, y0: Any, sigma: float, out: Any) -> None:
+    """y(σ) = y0 + σ(c_0 + σ(c_1 + ...)) into ``out`` (Horner, as
+    ``PolynomialDenseOutput``)."""
+    last = coefficients.shape[0] - 1
+    for k in range(y0.size):
+        total = coefficients[last, k] * sigma
+        for q in range(last - 1, -1, -1):
+            total = (total + coefficients[q, k]) * sigma
+        out[k] = y0[k] + total
+
+
+#: The functions of numbers a compiled path compiles (callees before callers).
+KERNELS = (propose, advance, judge, dense_coefficients, dense_state)

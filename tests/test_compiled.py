@@ -1,0 +1,187 @@
+"""The compiled path against the numpy path: the same outcomes and results, scene by
+scene, for every built-in failure model (issue 23, item 2), the engine choice, and the
+fallback where numba is missing.
+
+The paths share every formula and take the same steps, so they differ only by rounding.
+numpy's vectorised arccos, arctan2 and pow (its AVX-512 builds) differ from the C
+library's, which numba calls, in the last bit; a last-bit difference can move a branch
+landing and so a result by up to the integration tolerance. The 1e-12 comparison
+therefore runs the numpy path in a process whose numpy uses its baseline code
+(``NPY_DISABLE_CPU_FEATURES``: the C library's functions, as numba); a second test
+bounds what the default numpy's last bits do.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import plateimpact as pi
+from plateimpact.registry import presets
+
+numba = pytest.importorskip("numba")
+
+FAILURES = ("plugging", "hinge", "variable-pstar", "intact")
+SCENES = 2_000
+
+
+def batch(size: int = SCENES, seed: int = 23) -> pi.SceneBatch:
+    """Scenes over every preset: obliquity 0–80°, impact speed 50–1500 m/s."""
+    rng = np.random.default_rng(seed)
+    parts = []
+    names = list(presets.PLATES)
+    for k, name in enumerate(names):
+        count = size // len(names) + (1 if k < size % len(names) else 0)
+        part = pi.SceneBatch.grid(presets.DEFAULT_SPHERE, presets.plate(name), [100.0], [0.0])
+        part = pi.SceneBatch.concat([part] * count)
+        parts.append(
+            part.with_columns(
+                impact_speed=rng.uniform(50.0, 1500.0, count),
+                impact_obliquity=np.radians(rng.uniform(0.0, 80.0, count)),
+            )
+        )
+    return pi.SceneBatch.concat(parts)
+
+
+def run(failure: str, engine: str, scenes: pi.SceneBatch | None = None) -> pi.BatchResult:
+    simulation = pi.Simulation.from_names(failure=failure, engine=engine)
+    return simulation.run_batch(batch() if scenes is None else scenes)
+
+
+def _baseline_numpy_results(tmp_path: Path) -> dict[str, np.ndarray]:
+    """The numpy path's results in a process whose numpy runs its baseline code."""
+    from numpy._core._multiarray_umath import (  # noqa: PLC0415
+        __cpu_baseline__,
+        __cpu_dispatch__,
+        __cpu_features__,
+    )
+
+    dispatched = [f for f in __cpu_dispatch__ if __cpu_features__.get(f)]
+    disable = " ".join(f for f in dispatched if f not in __cpu_baseline__)
+    out = tmp_path / "numpy.npz"
+    script = (
+        "import sys, numpy as np\n"
+        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+        "from test_compiled import FAILURES, run\n"
+        "found = {}\n"
+        "for failure in FAILURES:\n"
+        "    r = run(failure, 'numpy')\n"
+        "    for name in ('outcome', 'plate_failed', 'exit_speed', 'exit_obliquity',"
+        " 'contact_time', 'max_penetration', 'failure_time', 'failure_penetration'):\n"
+        "        found[failure + '/' + name] = r.columns[name]\n"
+        "    for name, value in r.stats.items():\n"
+        "        found[failure + '/stats/' + name] = np.array(value)\n"
+        f"np.savez({str(out)!r}, **found)\n"
+    )
+    env = {**os.environ, "NPY_DISABLE_CPU_FEATURES": disable}
+    subprocess.run([sys.executable, "-c", script], check=True, env=env, timeout=600)
+    with np.load(out) as saved:
+        return dict(saved)
+
+
+@pytest.fixture(scope="module")
+def baseline(tmp_path_factory):
+    return _baseline_numpy_results(tmp_path_factory.mktemp("compiled"))
+
+
+@pytest.mark.parametrize("failure", FAILURES)
+def test_compiled_path_takes_the_numpy_paths_steps(failure, baseline):
+    """Same outcome, failure and work per scene; exit speed within 1e-12 Vs, exit
+    obliquity within 1e-9°, times and depths to rounding, on 2,000 scenes over every
+    preset: the same algorithm, step for step, with the same math library."""
+    scenes = batch()
+    compiled = run(failure, "compiled", scenes)
+    assert compiled.stats["compiled_scenes"] == scenes.size
+    expected = {k.split("/", 1)[1]: v for k, v in baseline.items() if k.startswith(failure + "/")}
+    c = compiled.columns
+    np.testing.assert_array_equal(c["outcome"], expected["outcome"])
+    np.testing.assert_array_equal(c["plate_failed"], expected["plate_failed"])
+    speed = scenes.columns["impact_speed"]
+    assert np.max(np.abs(c["exit_speed"] - expected["exit_speed"]) / speed) <= 1e-12
+    difference = np.abs(c["exit_obliquity"] - expected["exit_obliquity"])
+    assert np.degrees(np.max(difference)) <= 1e-9
+    radius = scenes.columns["radius"]
+    for name in ("max_penetration", "failure_penetration"):
+        np.testing.assert_array_equal(np.isnan(c[name]), np.isnan(expected[name]))
+        assert np.nanmax(np.abs(c[name] - expected[name]) / radius, initial=0.0) <= 1e-12
+    for name in ("contact_time", "failure_time"):
+        np.testing.assert_array_equal(np.isnan(c[name]), np.isnan(expected[name]))
+        scale = radius / speed  # Rs/Vs
+        assert np.nanmax(np.abs(c[name] - expected[name]) / scale, initial=0.0) <= 1e-10
+    for name in ("accepted_steps", "rejected_steps", "force_evaluations", "steps"):
+        assert compiled.stats[name] == int(expected["stats/" + name]), name
+
+
+@pytest.mark.parametrize("failure", FAILURES)
+def test_compiled_path_agrees_with_the_default_numpy(failure):
+    """With numpy's own vectorised math (last bits apart from the C library's), the
+    outcomes are the same and the exit speed and obliquity agree within what the
+    integration tolerance promises (2e-7 Vs, 1e-5°, docs/integrators.md)."""
+    scenes = batch(1_000, seed=5)
+    compiled, numpy_path = run(failure, "compiled", scenes), run(failure, "numpy", scenes)
+    np.testing.assert_array_equal(compiled.outcome, numpy_path.outcome)
+    speed = scenes.columns["impact_speed"]
+    assert np.max(np.abs(compiled.exit_speed - numpy_path.exit_speed) / speed) <= 2e-7
+    angle = np.abs(compiled.columns["exit_obliquity"] - numpy_path.columns["exit_obliquity"])
+    assert np.degrees(np.max(angle)) <= 1e-5
+
+
+def test_auto_runs_large_runs_compiled_and_small_ones_on_numpy():
+    """The engine is chosen once per run from its size, so chunking never changes it."""
+    from plateimpact.solve.driver import COMPILED_MIN_SCENES  # noqa: PLC0415
+
+    simulation = pi.Simulation.from_names(failure="plugging")
+    large = simulation.run_batch(batch(COMPILED_MIN_SCENES))
+    assert large.stats["compiled_scenes"] == COMPILED_MIN_SCENES
+    small = simulation.run_batch(batch(10))
+    assert small.stats["compiled_scenes"] == 0
+    chunked = simulation.run_batch(batch(COMPILED_MIN_SCENES), chunk_size=700)
+    assert chunked.stats["compiled_scenes"] == COMPILED_MIN_SCENES  # every chunk compiled
+    np.testing.assert_array_equal(chunked.exit_speed, large.exit_speed)
+
+
+def test_trajectories_and_numpy_only_plugins_stay_on_the_numpy_path():
+    from plateimpact.solve.driver import COMPILED_MIN_SCENES  # noqa: PLC0415
+
+    simulation = pi.Simulation.from_names(failure="plugging")
+    scenes = batch(COMPILED_MIN_SCENES)
+    with_paths = simulation.run_batch(scenes, record_trajectory=True)
+    assert with_paths.stats["compiled_scenes"] == 0
+    fixed = pi.Simulation.from_names(
+        failure="plugging", integrator_settings={"fixed_step": 0.01}, engine="auto"
+    )
+    assert fixed.run_batch(batch(COMPILED_MIN_SCENES)).stats["compiled_scenes"] == 0
+    with pytest.raises(pi.ParameterError, match="engine 'compiled' cannot run"):
+        pi.Simulation.from_names(
+            failure="plugging", integrator_settings={"fixed_step": 0.01}, engine="compiled"
+        ).run_batch(batch(5))
+
+
+def test_without_numba_the_numpy_path_runs_with_one_warning_line(monkeypatch):
+    """numba made unimportable (deterministically, in this process): the run completes
+    on the numpy path, and says so in one warning, once."""
+    from plateimpact.solve import driver  # noqa: PLC0415
+
+    monkeypatch.setitem(sys.modules, "numba", None)  # import numba -> ImportError
+    monkeypatch.setattr(driver, "_warned", set())
+    simulation = pi.Simulation.from_names(failure="plugging")
+    scenes = batch(driver.COMPILED_MIN_SCENES)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        first = simulation.run_batch(scenes)
+        simulation.run_batch(scenes)
+    said = [w for w in caught if issubclass(w.category, pi.CompiledPathWarning)]
+    assert len(said) == 1 and "\n" not in str(said[0].message)
+    assert "numba is not installed" in str(said[0].message)
+    assert first.stats["compiled_scenes"] == 0 and np.all(first.outcome > 0)
+
+
+def test_engine_is_validated():
+    with pytest.raises(pi.ParameterError, match="engine must be one of auto, compiled, numpy"):
+        pi.Simulation.from_names(engine="fast")
