@@ -169,7 +169,8 @@ def plot_outcome_map(maps: Sequence[tuple[str, OutcomeMap]]) -> Figure:
     fig.legend(handles=regime_key(present), loc="outside lower center", fontsize=SMALL,
                frameon=False, ncols=columns)  # fmt: skip
     details = "; ".join(dict.fromkeys(_details(found) for _, found in maps))
-    title = textwrap.fill(f"Outcome maps: {details}", int(width * 16))  # 16 chars per in
+    heading = "Outcome maps" if len(maps) > 1 else "Outcome map"
+    title = textwrap.fill(f"{heading}: {details}", int(width * 16))  # 16 chars per in
     fig.suptitle(title, fontsize=FONT)
     return fig
 
