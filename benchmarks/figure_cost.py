@@ -1,14 +1,16 @@
 """The cost of the outcome-map figure: drawing and saving the five plates' maps as
 `plateimpact reproduce` draws ``outcome_maps.png`` (issue 23, item 5).
 
-python benchmarks/figure_cost.py [--archive report/report.h5] [--repeats 5] [--out maps.png]
+python benchmarks/figure_cost.py [--archive report/report.h5] [--repeats 5] [--plates 5]
+                                 [--dpi 150] [--out maps.png]
 
 The maps are those ``reproduce`` stored in ``--archive`` (``limits/map_PLATE``), or by
 default synthetic maps on ``reproduce``'s grid (100 speeds over 50-2000 m/s, 43
 obliquities 0-84 deg, five plates), whose boundaries are closed-form curves, so no scene
-runs. Prints each repetition's time of drawing and of saving [s], their medians and the
-figure's size. Compare two versions of the code by running this script with each, turn
-about, on the same maps.
+runs; ``--plates 1`` draws the first alone, as ``plateimpact map`` does. Prints each
+repetition's time of drawing and of saving [s], their medians and the figure's size.
+Compare two versions of the code by running this script with each, in turn, on the
+same maps.
 """
 
 from __future__ import annotations
@@ -76,10 +78,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--archive", help="read the maps reproduce stored here")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--plates", type=int, default=5, choices=range(1, 6))
     parser.add_argument("--dpi", type=float, default=saving.DPI)
     parser.add_argument("--out", help="keep the last figure here (its extension: the format)")
     args = parser.parse_args()
-    maps = maps_of(args.archive)
+    maps = maps_of(args.archive)[: args.plates]
     shape = f"{len(maps)} maps of {maps[0][1].shape[0]} x {maps[0][1].shape[1]}"
     print(f"{shape} ({'synthetic' if args.archive is None else args.archive})")
     with tempfile.TemporaryDirectory() as scratch:
