@@ -37,8 +37,8 @@ SUFFIXES: dict[str, tuple[str, ...] | None] = {
 
 #: Resolution of saved raster figures by default, and the range ``--dpi`` accepts [dots
 #: per inch]: at 50 a study figure (7.2 in) is a 360-pixel thumbnail; 1200
-#: meets any journal's line-art rule, and there the 8 x 25 in outcome maps of
-#: ``reproduce`` are 290 megapixels (1.8 GB, 50 s). Print wants SVG or PDF anyway.
+#: meets any journal's line-art rule, and there ``reproduce``'s figures are 34-72
+#: megapixels each (0.8 GB at the peak). Print wants SVG or PDF anyway.
 FIGURE_DPI = 150.0
 #: What a temporary's name adds to its target's: ``.`` and ``.PID.XXXXXXXX.tmp``, the PID
 #: up to 7 digits (Linux's largest pid_max, 2**22) [bytes].
