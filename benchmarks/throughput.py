@@ -1,7 +1,11 @@
-"""Wall time of a 10,000-scene sweep with the default integrator, and what each skip saves.
+"""Wall time of a 10,000-scene sweep with the default integrator on each path, and what
+each skip saves.
 
-  * the sweep: minimum of 5 runs after a warm-up, in this process (the machine is shared:
-    single runs vary by ±20%);
+  * the sweep on the compiled path (one thread, then one per core), on the numpy path,
+    and through scipy's DOP853 (solve_ivp, one run) at the default rtol, on the same
+    scenes; the compiled path's results against the numpy path's;
+  * the numpy sweep: minimum of 5 runs after a warm-up, in this process (the machine is
+    shared: single runs vary by ±20%);
   * the same sweep spread over a 2-process pool (one chunk per core): warm, and including
     the pool's start;
   * trajectories: the same sweep recording them (they are off unless asked for);
@@ -19,6 +23,7 @@ import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 
+import attrs
 import numpy as np
 from scenes import benchmark_batch
 
@@ -36,22 +41,68 @@ def best_of(function, repeats=5):
     return min(times)
 
 
+def compiled_paths(batch: pi.SceneBatch, numpy_result: pi.BatchResult, numpy_time: float) -> None:
+    """The same sweep on the compiled path, on one thread and on every core."""
+    from plateimpact.solve.compiled import engine
+
+    compiled = attrs.evolve(pi.Simulation.from_names(), engine="compiled")
+    start = time.perf_counter()
+    result = compiled.run_batch(batch)  # compiles, or loads the program from the cache
+    print(f"compiled path: first run {time.perf_counter() - start:.2f} s (compile or cache load)")
+    speed = batch.columns["impact_speed"]
+    worst = np.max(np.abs(result.exit_speed - numpy_result.exit_speed) / speed)
+    angle = np.degrees(
+        np.max(np.abs(result.columns["exit_obliquity"] - numpy_result.columns["exit_obliquity"]))
+    )
+    same = np.array_equal(result.outcome, numpy_result.outcome)
+    print(
+        f"  against the numpy path: outcomes {'equal' if same else 'DIFFER'}, exit speed "
+        f"within {worst:.1e} Vs, exit obliquity within {angle:.1e} deg"
+    )
+    for threads in (1, os.cpu_count() or 1):
+        engine.set_threads(threads)
+        took = best_of(lambda: compiled.run_batch(batch))
+        print(
+            f"  {threads} thread(s): {took:.3f} s ({took / batch.size * 1e6:.1f} us per "
+            f"scene), {numpy_time / took:.1f}x the numpy path"
+        )
+    engine.set_threads(0)
+
+
+def scipy_reference(batch: pi.SceneBatch, numpy_result: pi.BatchResult, numpy_time: float) -> None:
+    """The same sweep through scipy's DOP853 at the default rtol (one run: it is slow)."""
+    rtol = pi.Simulation.from_names().integrator.rtol
+    scipy_run = pi.Simulation.from_names(
+        integrator="solve_ivp", integrator_settings={"method": "DOP853", "rtol": rtol}
+    )
+    start = time.perf_counter()
+    result = scipy_run.run_batch(batch)
+    took = time.perf_counter() - start
+    same = np.mean(result.outcome == numpy_result.outcome) * 100
+    print(
+        f"scipy DOP853 (solve_ivp) at rtol {rtol:g}: {took:.1f} s ({took / batch.size * 1e6:.0f} "
+        f"us per scene; {took / numpy_time:.0f}x the numpy path; outcomes equal on {same:.2f}%)"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", type=int, default=10_000)
     args = parser.parse_args()
     batch = benchmark_batch(args.scenes, seed=10_000)
-    simulation = pi.Simulation.from_names()
+    simulation = pi.Simulation.from_names(engine="numpy")
     print(f"integrator: {simulation.integrator.name} {simulation.integrator.settings()}")
 
     sweep = best_of(lambda: simulation.run_batch(batch))
     result = simulation.run_batch(batch)
     counts = np.bincount(result.outcome, minlength=4)[1:]
     print(
-        f"sweep of {batch.size} scenes: {sweep:.2f} s wall "
+        f"numpy path, sweep of {batch.size} scenes: {sweep:.2f} s wall "
         f"({sweep / batch.size * 1e6:.0f} us per scene; ricochet/embedment/perforation "
         f"{'/'.join(map(str, counts))})"
     )
+    compiled_paths(batch, result, sweep)
+    scipy_reference(batch, result, sweep)
 
     workers = os.cpu_count() or 1
     chunk = -(-batch.size // workers)
