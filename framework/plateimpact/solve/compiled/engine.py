@@ -106,7 +106,7 @@ def integrate_compiled(
     adds = [event in model.failure.events for event in (FAILURE_ONSET, PERFORATION)]
     ints = np.array(
         [control.branch_landing, *adds, integrator.max_steps,
-         2 + failure_kernels.branch_rows, Outcome.EMBEDMENT],
+         2 + failure_kernels.branch_rows, Outcome.EMBEDMENT, integrator.event_samples],
         dtype=np.int64,
     )  # fmt: skip
     outcomes = np.array([0 if e.outcome is None else int(e.outcome) for e in EVENTS], np.int64)

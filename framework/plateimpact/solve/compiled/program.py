@@ -69,7 +69,7 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
         )
         scene.integrate_scene(
             model, constants_i, tab, y[i], scale[i], core[i, 4], core[i, 5], ints[3],
-            ints[4], outcomes, restarts, ints[5], results[i], counts[i],
+            ints[4], ints[6], outcomes, restarts, ints[5], results[i], counts[i],
         )
 '''
 

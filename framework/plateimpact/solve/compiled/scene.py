@@ -26,8 +26,8 @@ COUNTS = 6
 
 def integrate_scene(
     model: CompiledModel, scene: SceneConstants, tab: Tableau, y: Any, scale: Any,
-    h_first: float, unit: float, max_steps: int, branch_rows: int, outcomes: Any,
-    restarts: Any, embedment: int, results: Any, counts: Any,
+    h_first: float, unit: float, max_steps: int, branch_rows: int, event_samples: int,
+    outcomes: Any, restarts: Any, embedment: int, results: Any, counts: Any,
 ) -> None:  # fmt: skip
     """Integrate the scene whose initial state is ``y`` (changed in place) and write its
     results into ``results`` and ``counts`` (outcome 0: unfinished after ``max_steps``).
@@ -40,7 +40,7 @@ def integrate_scene(
         np.empty((tab.P.shape[1], d)), np.empty(branch_rows), np.empty(branch_rows),
         np.zeros(branch_rows, np.bool_),
     )  # fmt: skip
-    at = np.linspace(0.0, 1.0, 5)
+    at = np.linspace(0.0, 1.0, event_samples)  # the integrator's event_samples
     events = outcomes.size
     ev = EventWork(
         at, np.empty((at.size, d)), np.empty((at.size, events)), np.empty(events),
