@@ -179,8 +179,7 @@ def run_in_chunks(
     # one engine for the whole run, from its size: a scene's result never depends on
     # how the run was chunked
     model, integrator = simulation.model, simulation.integrator
-    trajectories = record_trajectory or craters
-    engine = choose_engine(simulation.engine, model, integrator, bound.size, trajectories)
+    engine = choose_engine(simulation.engine, model, integrator, bound.size)
     chunks = (
         bound.take(np.arange(lo, min(lo + chunk_size, bound.size)))
         if chunk_size < bound.size

@@ -41,20 +41,15 @@ COMPILED_MIN_SCENES = 2000
 _warned: set[str] = set()
 
 
-def choose_engine(
-    requested: str, model: ImpactModel, integrator: Integrator, size: int, trajectories: bool
-) -> str:
+def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, size: int) -> str:
     """The engine a run of ``size`` scenes uses: "compiled" or "numpy". Under "auto",
-    a run the compiled path cannot take (trajectories asked for, plug-ins without
-    kernels, numba missing) runs on the numpy path; numba missing is said in one
-    warning line per process."""
+    a run the compiled path cannot take (plug-ins without kernels, numba missing) runs
+    on the numpy path; numba missing is said in one warning line per process."""
     if requested == "numpy" or (requested == "auto" and size < COMPILED_MIN_SCENES):
         return "numpy"
     from .compiled.engine import unavailable_reason  # noqa: PLC0415
 
     reason = unavailable_reason(model, integrator)
-    if reason is None and trajectories:
-        reason = "trajectories are recorded on the numpy path"
     if reason is None:
         try:
             import numba  # noqa: F401, PLC0415
@@ -95,7 +90,7 @@ def integrate(
     recorder = ResultRecorder(batch.size, record_trajectory, model.failure.state_names)
     if batch.size:
         bound = batch if isinstance(batch, BoundBatch) else model.bind(batch)
-        chosen = choose_engine(engine, model, integrator, bound.size, record_trajectory)
+        chosen = choose_engine(engine, model, integrator, bound.size)
         if chosen == "compiled" and _integrate_compiled(model, integrator, bound, recorder):
             recorder.stats["compiled_scenes"] = bound.size
         else:

@@ -106,18 +106,26 @@ def integrate_compiled(
     adds = [event in model.failure.events for event in (FAILURE_ONSET, PERFORATION)]
     ints = np.array(
         [control.branch_landing, *adds, integrator.max_steps,
-         2 + failure_kernels.branch_rows, Outcome.EMBEDMENT, integrator.event_samples],
+         2 + failure_kernels.branch_rows, Outcome.EMBEDMENT, integrator.event_samples,
+         0],
         dtype=np.int64,
     )  # fmt: skip
     outcomes = np.array([0 if e.outcome is None else int(e.outcome) for e in EVENTS], np.int64)
     restarts = np.array([e.restarts for e in EVENTS])
     results = np.full((n, scene.FLOAT_RESULTS), np.nan)
     counts = np.zeros((n, scene.COUNTS), np.int64)
-    arguments = (
-        table, y, scale, constants, law_constants,
-        *(np.ascontiguousarray(part, float) for part in pair[:5]),
-        floats, ints, outcomes, restarts, results, counts,
-    )  # fmt: skip
+    initial = y.copy()
+    nothing = np.empty((0, 2 + width))  # no trajectory written on the first pass
+
+    def arguments_with(*outputs: np.ndarray) -> tuple[np.ndarray, ...]:
+        state, settings, results, counts, trajectory, first_rows = outputs
+        return (
+            table, state, scale, constants, law_constants,
+            *(np.ascontiguousarray(part, float) for part in pair[:5]),
+            floats, settings, outcomes, restarts, results, counts, trajectory, first_rows,
+        )  # fmt: skip
+
+    arguments = arguments_with(y, ints, results, counts, nothing, np.zeros(n, np.int64))
     try:
         compiled.run(0, 0, *arguments)  # compiles, or loads numba's cache, here
     except Exception as exc:  # numba's errors: the numpy path runs instead
@@ -127,6 +135,23 @@ def integrate_compiled(
         ) from exc
     run_parallel(compiled.run, n, arguments)
     _record(recorder, results, counts, batch, integrator)
+    if recorder.record_trajectory:
+        # A second pass writes the samples the first one counted, each scene into its
+        # own rows: the same steps again (a scene's steps depend on nothing else).
+        sizes = counts[:, scene.SAMPLES]
+        first_rows = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+        trajectory = np.empty((int(sizes.sum()), 2 + width))
+        writing = ints.copy()
+        writing[-1] = 1
+        again = (np.empty_like(results), np.empty_like(counts))
+        second = arguments_with(initial, writing, *again, trajectory, first_rows)
+        run_parallel(compiled.run, n, second)
+        recorder.sample(
+            np.repeat(np.arange(n), sizes),
+            trajectory[:, scene.TIME],
+            trajectory[:, 2:].T,
+            trajectory[:, scene.FAILED] == 1.0,
+        )
 
 
 def _record(

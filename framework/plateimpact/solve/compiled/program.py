@@ -59,7 +59,7 @@ from plateimpact.solve.compiled.stepping import Tableau
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, floats, ints,
-        outcomes, restarts, results, counts):
+        outcomes, restarts, results, counts, trajectory, first_rows):
     model = CompiledModel({slots})
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
     for i in range(start, stop):
@@ -70,6 +70,7 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
         scene.integrate_scene(
             model, constants_i, tab, y[i], scale[i], core[i, 4], core[i, 5], ints[3],
             ints[4], ints[6], outcomes, restarts, ints[5], results[i], counts[i],
+            ints[7] != 0, trajectory, first_rows[i],
         )
 '''
 

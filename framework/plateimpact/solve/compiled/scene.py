@@ -20,19 +20,34 @@ EXIT_SPEED, EXIT_OBLIQUITY, CONTACT_TIME, MAX_PENETRATION = 0, 1, 2, 3
 FAILURE_TIME, FAILURE_PENETRATION, FAILURE_LATERAL = 4, 5, 6
 LAST_PENETRATION, LAST_SPEED, LAST_TIME = 7, 8, 9
 FLOAT_RESULTS = 10
-OUTCOME, PLATE_FAILED, STEPS, ACCEPTED, REJECTED, FORCE_EVALUATIONS = range(6)
-COUNTS = 6
+OUTCOME, PLATE_FAILED, STEPS, ACCEPTED, REJECTED, FORCE_EVALUATIONS, SAMPLES = range(7)
+COUNTS = 7
+#: Columns of a trajectory row before the state: time [s], and whether the plate had failed.
+TIME, FAILED = 0, 1
+
+
+def record(trajectory: Any, row: int, writing: bool, time: float, y: Any, failed: bool) -> int:
+    """Write a trajectory sample (time [s], failed, state) at ``row`` if ``writing``;
+    the next row. Counted either way, so that a counting pass sizes the writing one."""
+    if writing:
+        trajectory[row, TIME] = time
+        trajectory[row, FAILED] = 1.0 if failed else 0.0
+        trajectory[row, 2:] = y
+    return row + 1
 
 
 def integrate_scene(
     model: CompiledModel, scene: SceneConstants, tab: Tableau, y: Any, scale: Any,
     h_first: float, unit: float, max_steps: int, branch_rows: int, event_samples: int,
     outcomes: Any, restarts: Any, embedment: int, results: Any, counts: Any,
+    writing: bool, trajectory: Any, first_row: int,
 ) -> None:  # fmt: skip
     """Integrate the scene whose initial state is ``y`` (changed in place) and write its
     results into ``results`` and ``counts`` (outcome 0: unfinished after ``max_steps``).
     ``outcomes`` and ``restarts``: each event's outcome code (0: goes on) and whether
-    the right-hand side changes there (from :data:`plateimpact.model.events.EVENTS`)."""
+    the right-hand side changes there (from :data:`plateimpact.model.events.EVENTS`).
+    Trajectory samples, where the numpy driver records them, are counted in ``counts``
+    and, if ``writing``, written to ``trajectory`` from ``first_row``."""
     d = y.size
     s = tab.C.size
     work = StepWork(
@@ -54,6 +69,7 @@ def integrate_scene(
     h_next, just_rejected, forced = h_first, False, False
     rates(model, scene, y, failed, held, work.stages[0])  # first same as last
     evaluations = 1
+    row = record(trajectory, first_row, writing, t, y, failed)
     accepted = rejected = steps = 0
     for _ in range(max_steps):
         steps += 1
@@ -97,13 +113,19 @@ def integrate_scene(
         if crest_sigma < end_sigma:
             dense_state(work.coefficients, y, crest_sigma, work.trial)
             peak = np.maximum(peak, work.trial[P_])
+            # the deepest point belongs to the path
+            row = record(trajectory, row, writing, t + crest_sigma * h, work.trial, failed)
         max_penetration = np.maximum(max_penetration, peak)
+        for j in range(1, at.size):
+            if at[j] < end_sigma:
+                row = record(trajectory, row, writing, t + at[j] * h, samples[j], failed)
         t = t + end_sigma * h
         y[:] = ev.state
         work.stages[0, :] = work.stages[s]  # the carried derivative (FSAL)
         known_margins[:] = margins[at.size - 1]
         known = not hit
         if not hit:
+            row = record(trajectory, row, writing, t, y, failed)  # the step's end
             continue
         if kind == ONSET:
             failed = True
@@ -112,6 +134,7 @@ def integrate_scene(
                 model.initial_state(contact, y[STATE:])
             results[FAILURE_TIME], results[FAILURE_PENETRATION] = t, y[P_]
             results[FAILURE_LATERAL] = y[Y_]
+        row = record(trajectory, row, writing, t, y, failed)  # the step's end
         if kind == TURNED_BACK:
             held = True
             y[THETA_] = scene.max_obliquity
@@ -128,8 +151,9 @@ def integrate_scene(
     counts[PLATE_FAILED] = 1 if failed else 0
     counts[STEPS], counts[ACCEPTED], counts[REJECTED] = steps, accepted, rejected
     counts[FORCE_EVALUATIONS] = evaluations
+    counts[SAMPLES] = row - first_row
     results[LAST_PENETRATION], results[LAST_SPEED], results[LAST_TIME] = y[P_], y[V_], t
 
 
 #: The functions of numbers a compiled path compiles.
-KERNELS = (integrate_scene,)
+KERNELS = (record, integrate_scene)
