@@ -29,14 +29,15 @@ from .integrator import Integrator, StepperState
 from .recorder import ResultRecorder
 
 #: How a batch is integrated: "compiled" (numba; :mod:`plateimpact.solve.compiled`),
-#: "numpy" (this module's loop), or "auto": compiled wherever the plug-ins provide
-#: kernels and the run has at least COMPILED_MIN_SCENES scenes.
+#: "numpy" (this module's loop), or "auto": compiled wherever the model's plug-ins
+#: provide kernels and numba is installed.
 ENGINES = ("auto", "compiled", "numpy")
-#: Below this many scenes "auto" keeps a run on the numpy path: loading the compiled
-#: program (numba's import and its cache, about half a second) would cost more than the
-#: run (100 µs a scene on the numpy path). Decided per run, never per chunk, so that a
-#: scene's result never depends on how its run was chunked.
-COMPILED_MIN_SCENES = 2000
+#: "auto" runs every run of at least this many scenes compiled. One: the choice never
+#: depends on a run's size, so a scene's result never depends on the batch or chunk it
+#: ran in. Loading the compiled program costs 0.4 s a process (numba's import and its
+#: cache); the numpy loop costs about 1 ms a step whatever the batch (0.25 s for even a
+#: few scenes), the compiled one 30 µs a scene.
+COMPILED_MIN_SCENES = 1
 
 _warned: set[str] = set()
 
