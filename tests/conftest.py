@@ -3,6 +3,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -153,17 +154,43 @@ def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The output directory of ``plateimpact reproduce --quick --dpi 50``, made once per
     session: the archive ``report.h5`` (every study, variant and setting kind of the
     report, the stored outcome maps) and the figures and P* table. Read it only: copy
-    it (``shutil.copytree``) to change it."""
+    it (``shutil.copytree``) to change it.
+
+    Under pytest-xdist it is made once for all workers (about 15 s of CPU): the first
+    worker to need it makes it, under a lock, in the session's directory they share;
+    each then reads its own copy, whose archive lock file it rewrites (an ``upgrade``
+    that refuses the current format, as a writer does) so that the file names this
+    process, as it would had this process written the report."""
     import contextlib
+    import fcntl
     import io
 
     from plateimpact.cli import main
 
+    def quietly(argv: list[str]) -> tuple[int, str]:
+        printed, errors = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(errors):
+            code = main(argv)
+        return code, errors.getvalue()
+
     out = tmp_path_factory.mktemp("quick") / "report"
-    printed, errors = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(errors):
-        code = main(["reproduce", "--quick", "--out", str(out), "--dpi", "50"])
-    assert code == 0, errors.getvalue()
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:  # one process: made here
+        code, errors = quietly(["reproduce", "--quick", "--out", str(out), "--dpi", "50"])
+        assert code == 0, errors
+        return out
+    shared = tmp_path_factory.getbasetemp().parent / "quick_report"  # this session's
+    shared.mkdir(exist_ok=True)
+    made, master = shared / "made", shared / "report"
+    with open(shared / "lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # let go when the file closes
+        if not made.exists():
+            shutil.rmtree(master, ignore_errors=True)  # another worker's, failed half-way
+            code, errors = quietly(["reproduce", "--quick", "--out", str(master), "--dpi", "50"])
+            assert code == 0, errors
+            made.touch()
+    shutil.copytree(master, out)
+    code, errors = quietly(["upgrade", str(out / "report.h5")])
+    assert code == 2 and "nothing to upgrade" in errors, errors
     return out
 
 

@@ -245,7 +245,9 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
     assert not any(m.startswith(("plateimpact.cli", "plateimpact.storage")) for m in core)
     # run --json (and so sweep's FILE.json) and the archive's run attribute.
     argv = ["run", "--preset", "2024-T3/3.18", "--speed", "640", "--obliquity", "60"]
-    argv += ["--failure", "hinge", "--integrator", "segment", "--json"]
+    # (segment at a coarse step: the record is the code's, whatever the settings)
+    argv += ["--failure", "hinge", "--integrator", "segment", "--set", "integrator.step=0.02"]
+    argv += ["--json"]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert json.loads(printed)["inputs"]["plugins"] == record
@@ -253,7 +255,9 @@ def test_every_output_records_the_code_that_made_it(tmp_path, capsys):
     saved.write_text(printed)
     assert main(["run", "--inputs", str(saved), "--json"]) == 0  # read back, provenance aside
     assert capsys.readouterr().out == printed
-    variant = pi.Variant("v", failure="hinge", integrator="segment")
+    variant = pi.Variant(
+        "v", failure="hinge", integrator="segment", integrator_settings={"step": 0.02}
+    )
     pi.Study.grid("s", ["2024-T3/3.18"], [0], [640.0], variant).run(archive=tmp_path / "a.h5")
     assert pi.Archive(tmp_path / "a.h5").metadata("v")["plugins"] == record
 

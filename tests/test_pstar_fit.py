@@ -294,7 +294,9 @@ def test_a_search_that_does_not_converge_is_one_line(aluminium_shots, capsys, mo
 
 def test_an_alpha_fit_that_does_not_converge_is_one_line(aluminium_shots, capsys, monkeypatch):
     monkeypatch.setattr(pstar_search, "ALPHA_FIT_EVALUATIONS", 2)  # Nelder-Mead needs more
-    args = ["calibrate", str(aluminium_shots), "--fit", "pstar", "--alpha-fit", *PLATE, *FAST]
+    # how finely the boundaries are found does not decide that: the coarsest finder
+    coarse = ["--rtol", "1e-6", "--resolution", "50", "--tolerance", "5"]
+    args = ["calibrate", str(aluminium_shots), "--fit", "pstar", "--alpha-fit", *PLATE, *coarse]
     assert main(args) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "alpha* fit (Nelder-Mead) did not converge" in err

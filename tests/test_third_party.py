@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from conftest import THIRD_PARTY
 from scipy.integrate import solve_ivp
+from test_output_files import run_cli as run_in_process
 
 import plateimpact as pi
 from plateimpact import presets
@@ -81,9 +82,20 @@ def test_its_constant_and_setting_reach_the_law(with_third_party):
 
 
 def run_cli(*args, check=True):
+    """The command in a new interpreter that finds the package on its PYTHONPATH, as a
+    user's shell does: its exit code and start-up are what these runs check."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(THIRD_PARTY), *sys.path])}
     command = [sys.executable, "-m", "plateimpact.cli", *args]
     return subprocess.run(command, capture_output=True, text=True, env=env, check=check)
+
+
+def run_here(*args: str) -> str:
+    """What the command prints, run in this process (the package installed by the
+    ``with_third_party`` fixture): the same parsing, registry and output as run_cli's,
+    without an interpreter's start-up for each of many runs."""
+    code, out, err = run_in_process(list(args))
+    assert code == 0, err
+    return out
 
 
 def test_from_the_command_line_set_and_the_declared_flag_match_python(with_third_party, tmp_path):
@@ -100,7 +112,7 @@ def test_from_the_command_line_set_and_the_declared_flag_match_python(with_third
         ["--set", "plate.rate_sensitivity=0.3", "--set", "resistance.reference_speed=50"],
     ]
     for way in ways:
-        out = json.loads(run_cli(*base, *model, *way).stdout)
+        out = json.loads(run_here(*base, *model, *way))
         assert out["outcome"] == expected.outcome.label
         assert out["exit_speed_m_s"] == expected.exit_speed
         assert out["model"]["resistance_settings"] == {"reference_speed": 50.0}
@@ -183,7 +195,7 @@ def test_its_failure_model_and_integrator_from_the_command_line_and_a_plate_file
         ["--preset", "6061-T6/9.53", "--pstar", "2"],
         ["--plate-file", str(plate_file)],
     ):
-        out = json.loads(run_cli("run", *source, *scene, *model).stdout)
+        out = json.loads(run_here("run", *source, *scene, *model))
         assert out["outcome"] == "perforation"
         assert out["exit_speed_m_s"] == expected.exit_speed
         assert out["model"]["failure"] == "brittle"
