@@ -92,25 +92,23 @@ def advance(
     stages, s = work.stages, tab.C.size
     for i in range(1, s):
         for k in range(y.size):
-            total = 0.0
-            for j in range(i):
-                if tab.A[i, j] != 0.0:
-                    total += tab.A[i, j] * stages[j, k]
-            work.trial[k] = y[k] + h * total
+            work.trial[k] = y[k] + h * combine(tab.A[i, :i], stages, k)
         rates(model, scene, work.trial, failed, held, stages[i])
     for k in range(y.size):
-        total = 0.0
-        for j in range(tab.B.size):
-            if tab.B[j] != 0.0:
-                total += tab.B[j] * stages[j, k]
-        work.y_new[k] = y[k] + h * total
+        work.y_new[k] = y[k] + h * combine(tab.B, stages, k)
     rates(model, scene, work.y_new, failed, held, stages[s])
     for k in range(y.size):
-        total = 0.0
-        for j in range(tab.E.size):
-            if tab.E[j] != 0.0:
-                total += tab.E[j] * stages[j, k]
-        work.error[k] = h * total
+        work.error[k] = h * combine(tab.E, stages, k)
+
+
+def combine(weights: Any, stages: Any, k: int) -> float:
+    """Σ_j weights[j] · stages[j, k], in stage order, zero weights skipped (the numpy
+    stepper's ``_combine`` for one component)."""
+    total = 0.0
+    for j in range(weights.size):
+        if weights[j] != 0.0:
+            total += weights[j] * stages[j, k]
+    return total
 
 
 def judge(
@@ -186,4 +184,4 @@ def dense_state(coefficients: Any, y0: Any, sigma: float, out: Any) -> None:
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
-KERNELS = (propose, advance, judge, dense_coefficients, dense_state)
+KERNELS = (combine, propose, advance, judge, dense_coefficients, dense_state)
