@@ -129,7 +129,7 @@ def test_contact_force_kernel_equals_the_laws_force(compiled, states):
 def _force_per_scene(compiled, states, depth=None):
     """Drag and lift [N] of the compiled force (or relief, below ``depth``) per scene."""
     force = compiled["force_on_contact"]
-    geometry_c, stress_c = compiled["contact_geometry_kernel"], compiled["poncelet_stress"]
+    geometry_c, stress_c = compiled["contact_surface_kernel"], compiled["poncelet_stress"]
     out = []
     for i in range(N):
         p, theta, speed, rs = (

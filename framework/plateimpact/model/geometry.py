@@ -138,9 +138,21 @@ def presented_area(penetration: Any, obliquity: Any, radius: Any, inclination: A
     eq 4) and the below-surface segment of the great disc normal to the velocity (radius
     Rs, central angle Γs, eq 5).
     """
+    return _surface(penetration, obliquity, radius, inclination)[0]
+
+
+def _surface(
+    penetration: Any, obliquity: Any, radius: Any, inclination: Any
+) -> tuple[Any, Any, Any, Any, Any, Any]:
+    """A [m²] (eq 2), φ [rad], cos ψ and sin ψ of the incidence ψ = θ − φ (eq 22), and
+    sin θ, cos θ, with each sine and cosine evaluated once: the force needs them all
+    (eqs 2, 23, 24), and the motion sin θ and cos θ (eqs 25, 26)."""
+    sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
+    sin_phi, cos_phi = np.sin(inclination), np.cos(inclination)
+    cos_psi = cos_t * cos_phi + sin_t * sin_phi  # cos(θ − φ)
+    sin_psi = sin_t * cos_phi - cos_t * sin_phi  # sin(θ − φ)
     centre_height = radius - penetration  # height of the centre above the front plane
     re_squared = embedment_radius_squared(penetration, radius)
-    sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
     # eq 4, (Rs − P)/(Re tan θ) written with sin and cos so that θ = 0 is a limit.
     ratio_e = limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t)
     ratio_s = limit_ratio(centre_height, radius * sin_t)  # eq 5
@@ -150,9 +162,35 @@ def presented_area(penetration: Any, obliquity: Any, radius: Any, inclination: A
     chord_s = 2.0 * ratio_s * np.sqrt(1.0 - ratio_s * ratio_s)
     segment_e = TWO_PI - 2.0 * np.arccos(ratio_e) + chord_e  # Γe − sin Γe
     segment_s = 2.0 * np.arccos(ratio_s) - chord_s  # Γs − sin Γs
-    return 0.5 * re_squared * segment_e * np.cos(inclination) + 0.5 * radius**2 * segment_s * (
-        np.cos(obliquity - inclination)
-    )  # eq 2
+    area = 0.5 * re_squared * segment_e * cos_phi + 0.5 * radius**2 * segment_s * cos_psi  # eq 2
+    return area, inclination, cos_psi, sin_psi, sin_t, cos_t
+
+
+def contact_surface(
+    penetration: Any, obliquity: Any, radius: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Presented area A [m²] (eq 2), force inclination φ [rad] (eq 6), cos ψ and sin ψ
+    of the incidence ψ = θ − φ (eq 22), and sin θ, cos θ at ``penetration`` P [m],
+    ``obliquity`` θ [rad] in [0, π] and ``radius`` Rs [m], one per scene
+    (:func:`contact_surface_kernel`: for numbers). What
+    :func:`~plateimpact.model.resistance.force_on_contact` needs."""
+    penetration = np.asarray(penetration, dtype=float)
+    obliquity = np.asarray(obliquity, dtype=float)
+    radius = np.asarray(radius, dtype=float)
+    if not penetration.shape == obliquity.shape == radius.shape:
+        penetration, obliquity, radius = np.broadcast_arrays(penetration, obliquity, radius)
+    phi = force_inclination(penetration, obliquity, radius)
+    with np.errstate(divide="ignore", over="ignore"):  # limit_ratio's ±inf clip to ±1
+        return _surface(penetration, obliquity, radius, phi)
+
+
+def contact_surface_kernel(
+    penetration: float, obliquity: float, radius: float
+) -> tuple[float, float, float, float, float, float]:
+    """:func:`contact_surface` of numbers, (A [m²], φ [rad], cos ψ, sin ψ, sin θ, cos θ),
+    for a compiled path."""
+    phi = force_inclination_kernel(penetration, obliquity, radius)
+    return _surface(penetration, obliquity, radius, phi)
 
 
 def contact_geometry(
@@ -166,22 +204,16 @@ def contact_geometry(
     ----------
     penetration : P [m]; obliquity : θ [rad], in [0, π]; radius : Rs [m].
     """
-    penetration = np.asarray(penetration, dtype=float)
-    obliquity = np.asarray(obliquity, dtype=float)
-    radius = np.asarray(radius, dtype=float)
-    if not penetration.shape == obliquity.shape == radius.shape:
-        penetration, obliquity, radius = np.broadcast_arrays(penetration, obliquity, radius)
-    phi = force_inclination(penetration, obliquity, radius)
-    with np.errstate(divide="ignore", over="ignore"):  # limit_ratio's ±inf clip to ±1
-        return presented_area(penetration, obliquity, radius, phi), phi
+    area, phi = contact_surface(penetration, obliquity, radius)[:2]
+    return area, phi
 
 
 def contact_geometry_kernel(
     penetration: float, obliquity: float, radius: float
 ) -> tuple[float, float]:
     """:func:`contact_geometry` of numbers, (A [m²], φ [rad]), for a compiled path."""
-    phi = force_inclination_kernel(penetration, obliquity, radius)
-    return presented_area(penetration, obliquity, radius, phi), phi
+    area, phi = contact_surface_kernel(penetration, obliquity, radius)[:2]
+    return area, phi
 
 
 def branch_surfaces(penetration: Any, obliquity: Any, radius: Any) -> tuple[Any, Any]:
@@ -229,7 +261,9 @@ KERNELS = (
     ring_inclination,
     force_inclination_kernel,
     limit_ratio,
+    _surface,
     presented_area,
+    contact_surface_kernel,
     contact_geometry_kernel,
     branch_surfaces,
     contact_lost_margin,

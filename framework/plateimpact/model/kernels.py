@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, NamedTuple
 
-from .geometry import contact_geometry_kernel
+from .geometry import contact_surface_kernel
 from .resistance import force_on_contact
 
 
@@ -66,7 +66,7 @@ def law_force(
         obliquity,
         speed,
         contact.radius,
-        contact_geometry_kernel,
+        contact_surface_kernel,
         contact.stress,
         (contact.law_constants,),
     )

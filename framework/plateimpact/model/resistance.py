@@ -9,7 +9,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from .batch import SceneBatch
-from .geometry import contact_geometry
+from .geometry import contact_surface
 from .plugin import Plugin
 
 
@@ -53,7 +53,7 @@ def force_on_contact(
     obliquity: Any,
     speed: Any,
     radius: Any,
-    geometry: Callable[..., tuple[Any, Any]],
+    surface: Callable[..., tuple[Any, ...]],
     stress: Callable[..., Any],
     stress_args: tuple[Any, ...],
 ) -> tuple[Any, Any]:
@@ -61,15 +61,30 @@ def force_on_contact(
     ``obliquity`` θ [rad] and ``speed`` V [m/s] of a sphere of ``radius`` Rs [m]: the
     formula once, for arrays and numbers alike.
 
-    ``geometry(P, θ, Rs)`` gives the presented area A [m²] and force inclination φ [rad]
-    (:func:`~plateimpact.model.geometry.contact_geometry` on arrays, its ``_kernel`` on
-    numbers) and ``stress(V, ψ, *stress_args)`` the stress σ [N/m²] (a law's ``stress``
-    with its view of the scenes, or a compiled stress kernel with its constants).
+    ``surface(P, θ, Rs)`` gives the presented area A [m²], the force inclination φ [rad]
+    and cos ψ, sin ψ of the incidence (:func:`~plateimpact.model.geometry.contact_surface`
+    on arrays, its ``_kernel`` on numbers) and ``stress(V, ψ, *stress_args)`` the stress
+    σ [N/m²] (a law's ``stress`` with its view of the scenes, or a compiled stress kernel
+    with its constants).
     """
-    area, inclination = geometry(penetration, obliquity, radius)
-    incidence = obliquity - inclination  # ψ, eq 22
-    force = area * stress(speed, incidence, *stress_args)  # eq 1
-    return force * np.cos(incidence), force * np.sin(incidence)  # eqs 23, 24
+    return force_on_surface(
+        surface(penetration, obliquity, radius), obliquity, speed, stress, stress_args
+    )
+
+
+def force_on_surface(
+    surface: tuple[Any, ...],
+    obliquity: Any,
+    speed: Any,
+    stress: Callable[..., Any],
+    stress_args: tuple[Any, ...],
+) -> tuple[Any, Any]:
+    """:func:`force_on_contact` from the contact ``surface`` already evaluated at
+    ``obliquity`` θ [rad] (the geometry's A [m²], φ [rad], cos ψ, sin ψ, ...), at
+    ``speed`` V [m/s]: drag and lift [N] (eqs 1, 22–24)."""
+    area, inclination, cos_incidence, sin_incidence = surface[0], surface[1], surface[2], surface[3]
+    force = area * stress(speed, obliquity - inclination, *stress_args)  # eqs 1, 22
+    return force * cos_incidence, force * sin_incidence  # eqs 23, 24
 
 
 def contact_force(
@@ -89,7 +104,7 @@ def contact_force(
     ``batch`` is the law's view of the scenes.
     """
     return force_on_contact(
-        penetration, obliquity, speed, batch.radius, contact_geometry, law.stress, (batch,)
+        penetration, obliquity, speed, batch.radius, contact_surface, law.stress, (batch,)
     )
 
 
@@ -133,4 +148,4 @@ class BoundResistance:
 
 
 #: The functions of numbers a compiled path compiles.
-KERNELS = (force_on_contact,)
+KERNELS = (force_on_surface, force_on_contact)

@@ -14,9 +14,9 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ...model.events import AT_REST, CONTACT_LOST, ONSET, PERFORATED, TURNED_BACK
-from ...model.geometry import HALF_PI, branch_surfaces, contact_geometry_kernel, contact_lost_margin
+from ...model.geometry import HALF_PI, branch_surfaces, contact_lost_margin, contact_surface_kernel
 from ...model.kernels import KernelContact
-from ...model.resistance import force_on_contact
+from ...model.resistance import force_on_surface
 
 P_, Y_, THETA_, V_ = 0, 1, 2, 3  # rows of y (plateimpact.model.impact.PENETRATION ...)
 STATE = 4  # first failure-state row (KINEMATIC_STATE)
@@ -67,17 +67,17 @@ def rates(
     theta, speed = y[THETA_], y[V_]
     side = -1.0 if theta < 0.0 else 1.0
     obliquity = np.abs(theta)
-    drag, lift = force_on_contact(
-        y[P_], obliquity, speed, scene.radius, contact_geometry_kernel, model.stress,
-        (scene.law_constants,),
-    )  # fmt: skip
+    surface = contact_surface_kernel(y[P_], obliquity, scene.radius)
+    drag, lift = force_on_surface(surface, obliquity, speed, model.stress, (scene.law_constants,))
     if failed:
         extra_drag, extra_lift = model.force_change(contact_of(model, scene, y, obliquity, np.nan))
         drag, lift = drag + extra_drag, lift + extra_lift
     lift = side * lift
     obliquity_rate = 0.0 if held else lift / (scene.mass * speed)
-    out[P_] = speed * np.cos(theta)
-    out[Y_] = speed * np.sin(theta)
+    # cos θ = cos |θ| and sin θ = side · sin |θ| exactly (the libm's cos is even, its sin
+    # odd): the surface's own, not two more evaluations
+    out[P_] = speed * surface[5]
+    out[Y_] = speed * (side * surface[4])
     out[THETA_] = obliquity_rate
     out[V_] = -drag / scene.mass
     if failed:

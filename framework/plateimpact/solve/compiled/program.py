@@ -62,14 +62,15 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
         outcomes, restarts, results, counts, trajectory, first_rows):
     model = CompiledModel({slots})
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
+    work, ev, known_margins = scene.scratch(tab, y.shape[1], ints[4], ints[6], outcomes.size)
     for i in range(start, stop):
         constants_i = SceneConstants(
             core[i, 0], core[i, 1], core[i, 2], core[i, 3], floats[3], floats[4],
             ints[1] != 0, ints[2] != 0, constants[i], law_constants[i],
         )
         scene.integrate_scene(
-            model, constants_i, tab, y[i], scale[i], core[i, 4], core[i, 5], ints[3],
-            ints[4], ints[6], outcomes, restarts, ints[5], results[i], counts[i],
+            model, constants_i, tab, work, ev, known_margins, y[i], scale[i], core[i, 4],
+            core[i, 5], ints[3], outcomes, restarts, ints[5], results[i], counts[i],
             ints[7] != 0, trajectory, first_rows[i],
         )
 '''
@@ -128,15 +129,27 @@ def _kernel_modules(
 
 
 def _register(modules: list[ModuleType], chosen: dict[str, Callable[..., Any]]) -> None:
-    """Make every kernel callable from compiled code (once per process)."""
+    """Make every kernel callable from compiled code (once per process).
+
+    Kernels are compiled without numba's reference counting: they allocate nothing and
+    only borrow the arrays the batch loop owns, and the counting (an atomic add on
+    every array passed, sliced or put in a tuple) cost a fifth of the compiled time.
+    Only a module's ``ALLOCATING`` functions keep it; a kernel that allocates fails to
+    compile, and the model runs on the numpy path with the reason (docs/plugins.md).
+    """
     from numba.core.registry import CPUDispatcher  # noqa: PLC0415
     from numba.extending import register_jitable  # noqa: PLC0415
 
     functions = [f for module in modules for f in getattr(module, "KERNELS", ())]
-    for function in [*functions, *chosen.values()]:
+    allocating = [f for module in modules for f in getattr(module, "ALLOCATING", ())]
+    for function in [*functions, *chosen.values(), *allocating]:
         if id(function) in _registered or isinstance(function, CPUDispatcher):
             continue  # a numba dispatcher is callable from compiled code as it is
-        register_jitable(function)
+        counted = any(function is f for f in allocating)
+        if counted:
+            register_jitable(function)
+        else:
+            register_jitable(_nrt=False)(function)
         _registered.add(id(function))
 
 

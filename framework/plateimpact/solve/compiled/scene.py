@@ -26,19 +26,46 @@ COUNTS = 7
 TIME, FAILED = 0, 1
 
 
+def copy(target: Any, source: Any) -> None:
+    """target[:] = source, element by element (a slice assignment's broadcasting
+    machinery costs more than the copy of a few numbers)."""
+    for k in range(source.size):
+        target[k] = source[k]
+
+
 def record(trajectory: Any, row: int, writing: bool, time: float, y: Any, failed: bool) -> int:
     """Write a trajectory sample (time [s], failed, state) at ``row`` if ``writing``;
     the next row. Counted either way, so that a counting pass sizes the writing one."""
     if writing:
         trajectory[row, TIME] = time
         trajectory[row, FAILED] = 1.0 if failed else 0.0
-        trajectory[row, 2:] = y
+        for k in range(y.size):
+            trajectory[row, 2 + k] = y[k]
     return row + 1
 
 
+def scratch(
+    tab: Tableau, width: int, branch_rows: int, event_samples: int, events: int
+) -> tuple[StepWork, EventWork, Any]:
+    """The scratch arrays of one thread's scenes (allocated once per chunk: the kernels
+    that use them allocate nothing, so they run without reference counting)."""
+    s = tab.C.size
+    work = StepWork(
+        np.empty((s + 1, width)), np.empty(width), np.empty(width), np.empty(width),
+        np.empty((tab.P.shape[1], width)), np.empty(branch_rows), np.empty(branch_rows),
+        np.zeros(branch_rows, np.bool_),
+    )  # fmt: skip
+    at = np.linspace(0.0, 1.0, event_samples)  # the integrator's event_samples
+    ev = EventWork(
+        at, np.empty((at.size, width)), np.empty((at.size, events)), np.empty(events),
+        np.empty(width), np.empty(events),
+    )  # fmt: skip
+    return work, ev, np.empty(events)
+
+
 def integrate_scene(
-    model: CompiledModel, scene: SceneConstants, tab: Tableau, y: Any, scale: Any,
-    h_first: float, unit: float, max_steps: int, branch_rows: int, event_samples: int,
+    model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, ev: EventWork,
+    known_margins: Any, y: Any, scale: Any, h_first: float, unit: float, max_steps: int,
     outcomes: Any, restarts: Any, embedment: int, results: Any, counts: Any,
     writing: bool, trajectory: Any, first_row: int,
 ) -> None:  # fmt: skip
@@ -47,34 +74,27 @@ def integrate_scene(
     ``outcomes`` and ``restarts``: each event's outcome code (0: goes on) and whether
     the right-hand side changes there (from :data:`plateimpact.model.events.EVENTS`).
     Trajectory samples, where the numpy driver records them, are counted in ``counts``
-    and, if ``writing``, written to ``trajectory`` from ``first_row``."""
+    and, if ``writing``, written to ``trajectory`` from ``first_row``. ``work``, ``ev``
+    and ``known_margins``: scratch arrays (:func:`scratch`)."""
     d = y.size
     s = tab.C.size
-    work = StepWork(
-        np.empty((s + 1, d)), np.empty(d), np.empty(d), np.empty(d),
-        np.empty((tab.P.shape[1], d)), np.empty(branch_rows), np.empty(branch_rows),
-        np.zeros(branch_rows, np.bool_),
-    )  # fmt: skip
-    at = np.linspace(0.0, 1.0, event_samples)  # the integrator's event_samples
-    events = outcomes.size
-    ev = EventWork(
-        at, np.empty((at.size, d)), np.empty((at.size, events)), np.empty(events),
-        np.empty(d), np.empty(events),
-    )  # fmt: skip
-    known_margins = np.empty(events)
+    at = ev.at
     known = False
     failed = held = d < 0  # False, typed as a plain bool (a literal would compile twice)
     t = 0.0
     max_penetration = 0.0
     h_next, just_rejected, forced = h_first, False, False
+    margins_known = False  # work.margins holds the branch margins at y
     rates(model, scene, y, failed, held, work.stages[0])  # first same as last
     evaluations = 1
     row = record(trajectory, first_row, writing, t, y, failed)
     accepted = rejected = steps = 0
     for _ in range(max_steps):
         steps += 1
-        h, planned, landing = propose(model, scene, tab, work, y, h_next, unit, failed, forced)
-        forced = False
+        h, planned, landing = propose(
+            model, scene, tab, work, y, h_next, unit, failed, forced, margins_known
+        )
+        forced, margins_known = False, True
         advance(model, scene, tab, work, y, h, failed, held)
         evaluations += s
         ok, h_next, just_rejected, forced = judge(
@@ -87,12 +107,13 @@ def integrate_scene(
         # Sample the step; find the first event in it.
         dense_coefficients(tab, work, h)
         samples, margins = ev.samples, ev.margins
-        samples[0, :], samples[at.size - 1, :] = y, work.y_new
+        copy(samples[0], y)
+        copy(samples[at.size - 1], work.y_new)
         for j in range(1, at.size - 1):
             dense_state(work.coefficients, y, at[j], samples[j])
         for j in range(at.size):
             if j == 0 and known:
-                margins[0, :] = known_margins
+                copy(margins[0], known_margins)
             else:
                 event_margins(model, scene, samples[j], failed, held, margins[j])
         event_sigma, kind, crest_sigma = first_event(
@@ -108,7 +129,7 @@ def integrate_scene(
         if hit:
             dense_state(work.coefficients, y, end_sigma, ev.state)
         else:
-            ev.state[:] = work.y_new
+            copy(ev.state, work.y_new)
         peak = np.maximum(peak, ev.state[P_])
         if crest_sigma < end_sigma:
             dense_state(work.coefficients, y, crest_sigma, work.trial)
@@ -120,10 +141,13 @@ def integrate_scene(
             if at[j] < end_sigma:
                 row = record(trajectory, row, writing, t + at[j] * h, samples[j], failed)
         t = t + end_sigma * h
-        y[:] = ev.state
-        work.stages[0, :] = work.stages[s]  # the carried derivative (FSAL)
-        known_margins[:] = margins[at.size - 1]
+        copy(y, ev.state)
+        copy(work.stages[0], work.stages[s])  # the carried derivative (FSAL)
+        copy(known_margins, margins[at.size - 1])
         known = not hit
+        if not hit and tab.branch_landing:  # judge's margins at the step's end: now y's
+            copy(work.margins, work.ahead)
+        margins_known = not hit
         if not hit:
             row = record(trajectory, row, writing, t, y, failed)  # the step's end
             continue
@@ -156,4 +180,6 @@ def integrate_scene(
 
 
 #: The functions of numbers a compiled path compiles.
-KERNELS = (record, integrate_scene)
+KERNELS = (copy, record, integrate_scene)
+#: The kernels that allocate (compiled with reference counting; the rest without).
+ALLOCATING = (scratch,)

@@ -51,17 +51,19 @@ class StepWork(NamedTuple):
 
 def propose(
     model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, y: Any,
-    h_next: float, unit: float, failed: bool, forced: bool,
+    h_next: float, unit: float, failed: bool, forced: bool, margins_known: bool,
 ) -> tuple[float, float, bool]:  # fmt: skip
     """The step to attempt [s], the step it was planned to be, and whether it is
     shortened to land on a branch surface (``StepSizes.propose`` and
-    ``approach_branches``: the Euler prediction y + h f(y) of the surfaces)."""
+    ``approach_branches``: the Euler prediction y + h f(y) of the surfaces).
+    ``margins_known``: ``work.margins`` already holds the branch margins at ``y``."""
     h = np.minimum(h_next, tab.max_step * unit)
     if not tab.branch_landing:
         return h, h, False
     planned = h
     derivative = work.stages[0]
-    branch_margins(model, scene, y, failed, work.margins)
+    if not margins_known:
+        branch_margins(model, scene, y, failed, work.margins)
     for k in range(y.size):
         work.trial[k] = y[k] + h * derivative[k]
     branch_margins(model, scene, work.trial, failed, work.ahead)
@@ -91,24 +93,25 @@ def advance(
     (``EmbeddedRungeKutta.advance``; sums in stage order, zero weights skipped)."""
     stages, s = work.stages, tab.C.size
     for i in range(1, s):
-        for k in range(y.size):
-            work.trial[k] = y[k] + h * combine(tab.A[i, :i], stages, k)
+        combine(tab.A[i], stages, y, h, work.trial)  # A is zero from column i on: skipped
         rates(model, scene, work.trial, failed, held, stages[i])
-    for k in range(y.size):
-        work.y_new[k] = y[k] + h * combine(tab.B, stages, k)
+    combine(tab.B, stages, y, h, work.y_new)
     rates(model, scene, work.y_new, failed, held, stages[s])
+    combine(tab.E, stages, y, 0.0, work.error)
     for k in range(y.size):
-        work.error[k] = h * combine(tab.E, stages, k)
+        work.error[k] = h * work.error[k]
 
 
-def combine(weights: Any, stages: Any, k: int) -> float:
-    """Σ_j weights[j] · stages[j, k], in stage order, zero weights skipped (the numpy
-    stepper's ``_combine`` for one component)."""
-    total = 0.0
-    for j in range(weights.size):
-        if weights[j] != 0.0:
-            total += weights[j] * stages[j, k]
-    return total
+def combine(weights: Any, stages: Any, y: Any, h: float, out: Any) -> None:
+    """out = y + h Σ_j weights[j] · stages[j] (or, with h = 0, the sum Σ_j alone), summed
+    in stage order with zero weights skipped, component by component: the numpy
+    stepper's ``_combine``."""
+    for k in range(out.size):
+        total = 0.0
+        for j in range(weights.size):
+            if weights[j] != 0.0:
+                total += weights[j] * stages[j, k]
+        out[k] = total if h == 0.0 else y[k] + h * total
 
 
 def judge(
