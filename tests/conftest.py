@@ -44,6 +44,22 @@ def pytest_report_header() -> str:
     return f"plateimpact time limits scaled by {SCALE:g} (PLATEIMPACT_TEST_TIME_SCALE)"
 
 
+@pytest.fixture(scope="session", autouse=True)
+def compiled_programs() -> None:
+    """The built-in models' compiled programs, compiled (or loaded) before any test runs,
+    so that every ``engine="auto"`` run in the suite takes the compiled path whatever the
+    cache held (no test depends on a background compile's timing). Each xdist worker
+    takes the programs in its own order; the programs' locks make each compile once."""
+    if importlib.util.find_spec("numba") is None:
+        return
+    from plateimpact.solve.compiled import warming
+
+    pairs = warming.compiled_pairs(pi.default_registry())
+    if os.environ.get("PYTEST_XDIST_WORKER", "gw0")[-1:] in "13579":
+        pairs.reverse()
+    warming.compile_pairs(pairs)
+
+
 @pytest.fixture(scope="session")
 def sphere() -> pi.Sphere:
     return presets.DEFAULT_SPHERE

@@ -116,6 +116,7 @@ def commands(archive: Path, tmp: Path) -> list[list[str]]:
          "--dpi", "50"],
         ["upgrade", str(old)],
         ["reproduce", "--quick", "--resume", "--out", str(report), "--dpi", "50"],
+        ["compile"],
     ]  # fmt: skip
 
 

@@ -9,7 +9,9 @@ recording, and dropping finished scenes. The integrator only steps
 
 from __future__ import annotations
 
+import importlib.util
 import math
+import os
 import time
 import warnings
 
@@ -39,29 +41,52 @@ ENGINES = ("auto", "compiled", "numpy")
 #: few scenes), the compiled one 30 µs a scene.
 COMPILED_MIN_SCENES = 1
 
+#: Set to "off", "auto" runs do not start compiling a program that is not ready.
+WARM_VARIABLE = "PLATEIMPACT_COMPILE"
+
 _warned: set[str] = set()
 
 
 def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, size: int) -> str:
-    """The engine a run of ``size`` scenes uses: "compiled" or "numpy". Under "auto",
-    a run the compiled path cannot take (plug-ins without kernels, numba missing) runs
-    on the numpy path; numba missing is said in one warning line per process."""
+    """The engine a run of ``size`` scenes uses: "compiled" or "numpy".
+
+    Under "auto", a run the compiled path cannot take (plug-ins without kernels, numba
+    missing or failing) runs on the numpy path, with one warning line per process where
+    numba is missing or failed; so does a run whose compiled program is not ready yet,
+    while a detached process compiles it (:mod:`.compiled.warming`: no run waits for
+    numba; ``plateimpact compile`` compiles every installed pair at once).
+    """
     if requested == "numpy" or (requested == "auto" and size < COMPILED_MIN_SCENES):
         return "numpy"
+    from .compiled import cache, warming  # noqa: PLC0415
     from .compiled.engine import unavailable_reason  # noqa: PLC0415
 
     reason = unavailable_reason(model, integrator)
-    if reason is None:
-        try:
-            import numba  # noqa: F401, PLC0415
-        except ImportError:
-            reason = "numba is not installed (pip install 'plateimpact[fast]')"
-            if requested == "auto":
-                warn_once(reason)
-    if reason is None:
-        return "compiled"
+    law, failure = type(model.resistance), type(model.failure)
+    if reason is None and importlib.util.find_spec("numba") is None:
+        reason = "numba is not installed (pip install 'plateimpact[fast]')"
+        if requested == "auto":
+            warn_once(reason)
+    if reason is not None:
+        if requested == "compiled":
+            raise ParameterError("engine", f"engine 'compiled' cannot run this model: {reason}")
+        return "numpy"
     if requested == "compiled":
-        raise ParameterError("engine", f"engine 'compiled' cannot run this model: {reason}")
+        return "compiled"
+    try:
+        program = cache.status(law, failure)
+    except (ImportError, OSError) as exc:
+        warn_once(f"{type(exc).__name__}: {exc}")
+        return "numpy"
+    if program.ready:
+        return "compiled"
+    if program.failure:
+        warn_once(program.failure)
+    elif os.environ.get(WARM_VARIABLE, "background") != "off":
+        try:
+            warming.start(law, failure)
+        except OSError as exc:
+            warn_once(f"could not start compiling ({type(exc).__name__}: {exc})")
     return "numpy"
 
 
@@ -104,7 +129,8 @@ def _integrate_compiled(
 ) -> bool:
     """The batch on the compiled path; False (and one warning line) where the program
     could not be built or compiled, so that the numpy path runs it instead."""
-    from .compiled.engine import ProgramUnavailable, integrate_compiled  # noqa: PLC0415
+    from .compiled.building import ProgramUnavailable  # noqa: PLC0415
+    from .compiled.engine import integrate_compiled  # noqa: PLC0415
 
     try:
         integrate_compiled(model, integrator, batch, recorder)

@@ -55,6 +55,12 @@ COMMANDS = (
     ),
     Command("reproduce", "reproduce", "run the report's figure families into one archive"),
     Command(
+        "compile",
+        "compile",
+        "compile the fast path of every installed model now (otherwise it compiles in the "
+        "background on first use)",
+    ),
+    Command(
         "show", "show", "list an archive's runs and stored limits, their metadata and a summary"
     ),
     Command(

@@ -10,7 +10,6 @@ from typing import Any
 
 import numpy as np
 
-from ...base.errors import PluginError
 from ...model.binding import BoundBatch
 from ...model.events import EVENTS, FAILURE_ONSET, PERFORATION
 from ...model.impact import KINEMATIC_STATE, OBLIQUITY, SPEED, ImpactModel
@@ -20,7 +19,8 @@ from ..control import MAX_STEP
 from ..dynamics import Dynamics
 from ..integrator import Integrator
 from ..recorder import ResultRecorder
-from . import program, scene
+from . import scene
+from .building import build
 
 #: Scenes handed to a thread at a time: small enough to balance scenes of very different
 #: cost (a map's slow perforations beside its quick ricochets) over the cores, large
@@ -53,10 +53,6 @@ def run_parallel(run: Callable[..., None], n: int, arguments: tuple[Any, ...]) -
             future.result()
 
 
-class ProgramUnavailable(Exception):
-    """The pair's program could not be built, loaded or compiled: the reason, one line."""
-
-
 def unavailable_reason(model: ImpactModel, integrator: Integrator) -> str | None:
     """Why this model and integrator cannot run compiled (None: they can)."""
     if type(model.resistance).stress_kernel is None:
@@ -79,10 +75,7 @@ def integrate_compiled(
     pair = integrator.compiled_tableau()
     control = integrator.step_control()
     assert pair is not None and control is not None
-    try:
-        compiled = program.program(model.resistance, model.failure)
-    except (ImportError, OSError, PluginError) as exc:
-        raise ProgramUnavailable(f"{type(exc).__name__}: {exc}") from exc
+    compiled = build(type(model.resistance), type(model.failure))
     n = batch.size
     width = KINEMATIC_STATE + len(model.failure.state_names)
     failure_kernels = type(model.failure).kernels
@@ -98,7 +91,9 @@ def integrate_compiled(
     y[:, KINEMATIC_STATE:] = model.new_failure_state(n).T
     scale = np.ascontiguousarray(dynamics.component_scale(width).T)
     constants = np.ascontiguousarray(model.failure.kernel_constants(batch.failure).T, float)
-    law_constants = np.ascontiguousarray(model.resistance.kernel_constants(batch.resistance).T)
+    law_constants = np.ascontiguousarray(
+        model.resistance.kernel_constants(batch.resistance).T, float
+    )
     turn_back = ImpactModel.MAX_OBLIQUITY - ImpactModel.TURN_BACK_TOLERANCE
     floats = np.array(
         [pair.error_order, control.rtol, MAX_STEP, ImpactModel.MAX_OBLIQUITY, turn_back]
@@ -126,13 +121,6 @@ def integrate_compiled(
         )  # fmt: skip
 
     arguments = arguments_with(y, ints, results, counts, nothing, np.zeros(n, np.int64))
-    try:
-        compiled.run(0, 0, *arguments)  # compiles, or loads numba's cache, here
-    except Exception as exc:  # numba's errors: the numpy path runs instead
-        said = str(exc).strip().splitlines()
-        raise ProgramUnavailable(
-            f"compiling failed ({type(exc).__name__}: {said[0] if said else ''})"
-        ) from exc
     run_parallel(compiled.run, n, arguments)
     _record(recorder, results, counts, batch, integrator)
     if recorder.record_trajectory:

@@ -15,15 +15,17 @@ changed physics is a new file and a new compile, never stale code.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import os
 import sys
 import tempfile
 from collections.abc import Callable
+from importlib import metadata
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, NamedTuple
 
 from ...base.errors import PluginError
 from ...model import geometry, kernels, resistance
@@ -88,10 +90,12 @@ def cache_directory() -> Path:
     return Path(base) / "plateimpact" / "compiled"
 
 
-def pair_kernels(law: ResistanceLaw, failure: FailureModel) -> dict[str, Callable[..., Any]]:
-    """The pair's kernels by slot; PluginError if either plug-in provides none."""
-    stress = type(law).stress_kernel
-    declared = type(failure).kernels
+def pair_kernels(
+    law: type[ResistanceLaw], failure: type[FailureModel]
+) -> dict[str, Callable[..., Any]]:
+    """The pair's kernels by slot; PluginError if either plug-in class provides none."""
+    stress = law.stress_kernel
+    declared = failure.kernels
     if stress is None or declared is None:
         missing = f"resistance {law.name!r}" if stress is None else f"failure {failure.name!r}"
         raise PluginError(f"{missing} provides no compiled kernels")
@@ -111,14 +115,14 @@ def _module_of(function: Callable[..., Any]) -> ModuleType:
 
 
 def _kernel_modules(
-    law: ResistanceLaw, failure: FailureModel, chosen: dict[str, Callable[..., Any]]
+    law: type[ResistanceLaw], failure: type[FailureModel], chosen: dict[str, Callable[..., Any]]
 ) -> list[ModuleType]:
     """Every module whose KERNELS the pair's kernels may call: the core's, the kernels'
     own, and those of the plug-ins' classes and their bases."""
     found: list[ModuleType] = list(CORE_MODULES)
     candidates = [_module_of(f) for f in chosen.values()]
     for plugin in (law, failure):
-        for cls in type(plugin).__mro__:
+        for cls in plugin.__mro__:
             module = sys.modules.get(cls.__module__)
             if module is not None and hasattr(module, "KERNELS"):
                 candidates.append(module)
@@ -167,29 +171,48 @@ def _source(chosen: dict[str, Callable[..., Any]]) -> str:
 
 
 def _digest(source: str, modules: list[ModuleType]) -> str:
-    import numba  # noqa: PLC0415
     import numpy  # noqa: PLC0415
 
     digest = hashlib.sha256(source.encode())
     for module in modules:
         digest.update(Path(module.__file__ or "").read_bytes())
-    versions = (numba.__version__, numpy.__version__, sys.version)
+    # numba's version from its metadata: deciding whether a program is ready (warming)
+    # does not import numba
+    versions = (metadata.version("numba"), numpy.__version__, sys.version)
     digest.update(repr(versions).encode())
     return digest.hexdigest()[:20]
 
 
-def program(law: ResistanceLaw, failure: FailureModel) -> ModuleType:
+class Spec(NamedTuple):
+    """What a pair's program is made of: its digest (the file's name), its kernels by
+    slot, the modules whose kernels it compiles, and its source."""
+
+    key: str
+    chosen: dict[str, Callable[..., Any]]
+    modules: list[ModuleType]
+    source: str
+
+
+@functools.cache
+def spec(law: type[ResistanceLaw], failure: type[FailureModel]) -> Spec:
+    """The program of a (resistance law, failure model) pair of plug-in classes, not yet
+    built. Raises PluginError (no kernels) or PackageNotFoundError (no numba)."""
+    chosen = pair_kernels(law, failure)
+    modules = _kernel_modules(law, failure, chosen)
+    source = _source(chosen)
+    return Spec(_digest(source, modules), chosen, modules, source)
+
+
+def program(law: type[ResistanceLaw], failure: type[FailureModel]) -> ModuleType:
     """The pair's compiled program (a module whose ``run`` integrates a batch), generated
     and imported once per process; numba compiles it on first use, or loads it from its
     cache. Raises PluginError (no kernels), ImportError (no numba) or OSError (no
     writable cache directory)."""
-    chosen = pair_kernels(law, failure)
-    modules = _kernel_modules(law, failure, chosen)
-    source = _source(chosen)
-    key = _digest(source, modules)
+    made = spec(law, failure)
+    key, source = made.key, made.source
     if key in _programs:
         return _programs[key]
-    _register(modules, chosen)
+    _register(made.modules, made.chosen)
     directory = cache_directory()
     directory.mkdir(parents=True, exist_ok=True)
     path = directory / f"program_{key}.py"
@@ -199,10 +222,10 @@ def program(law: ResistanceLaw, failure: FailureModel) -> ModuleType:
         with tempfile.NamedTemporaryFile("w", dir=directory, suffix=".tmp", delete=False) as f:
             f.write(source)
         os.replace(f.name, path)
-    spec = importlib.util.spec_from_file_location(f"plateimpact_program_{key}", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # numba's cache finds the program's globals by name
-    spec.loader.exec_module(module)
+    found = importlib.util.spec_from_file_location(f"plateimpact_program_{key}", path)
+    assert found is not None and found.loader is not None
+    module = importlib.util.module_from_spec(found)
+    sys.modules[found.name] = module  # numba's cache finds the program's globals by name
+    found.loader.exec_module(module)
     _programs[key] = module
     return module
