@@ -28,6 +28,7 @@ from scenes import benchmark_batch
 
 import plateimpact as pi
 from plateimpact.figures import saving, style
+from plateimpact.solve.compiled import engine
 
 RESULTS = Path(__file__).resolve().parent / "results"
 #: The reference's tolerance. solve_ivp steps across the force's branch surfaces (it has
@@ -35,22 +36,31 @@ RESULTS = Path(__file__).resolve().parent / "results"
 #: set left the reference 1.5e-6 deg off in exit obliquity, a floor above dopri5's own
 #: errors at rtol 1e-10; at 1e-13 the two references agree to 1e-7 deg.
 REFERENCE_RTOL = 1e-13
-#: (series, integrator, settings). "dopri5, straddling" is dopri5 without stepping onto
-#: the force's branch surfaces (branch_landing=False), the default until this benchmark
-#: showed what landing saves.
+#: (series, integrator, settings, engine). "dopri5, straddling" is dopri5 without stepping
+#: onto the force's branch surfaces (branch_landing=False), the default until this
+#: benchmark showed what landing saves. "dopri5, compiled" is the same integrator on the
+#: compiled path, timed on one thread (per core, as the numpy path).
+DOPRI5_RTOLS = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
 CONFIGS = (
-    [("segment", "segment", {"step": s}) for s in (1e-2, 3e-3, 1e-3, 3e-4)]
-    + [("dopri5", "dopri5", {"rtol": r}) for r in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)]
+    [("segment", "segment", {"step": s}, "numpy") for s in (1e-2, 3e-3, 1e-3, 3e-4)]
+    + [("dopri5, numpy path", "dopri5", {"rtol": r}, "numpy") for r in DOPRI5_RTOLS]
+    + [("dopri5, compiled", "dopri5", {"rtol": r}, "compiled") for r in DOPRI5_RTOLS]
     + [
-        ("dopri5, straddling", "dopri5", {"rtol": r, "branch_landing": False})
+        ("dopri5, straddling", "dopri5", {"rtol": r, "branch_landing": False}, "numpy")
         for r in (1e-6, 1e-8, 1e-9, 3e-10, 1e-10)
     ]
     + [
-        ("solve_ivp DOP853", "solve_ivp", {"method": "DOP853", "rtol": r})
+        ("solve_ivp DOP853", "solve_ivp", {"method": "DOP853", "rtol": r}, "numpy")
         for r in (1e-6, 1e-8, 1e-10)
     ]
-    + [("solve_ivp RK45", "solve_ivp", {"method": "RK45", "rtol": r}) for r in (1e-6, 1e-8)]
-    + [("solve_ivp LSODA", "solve_ivp", {"method": "LSODA", "rtol": r}) for r in (1e-6, 1e-8)]
+    + [
+        ("solve_ivp RK45", "solve_ivp", {"method": "RK45", "rtol": r}, "numpy")
+        for r in (1e-6, 1e-8)
+    ]
+    + [
+        ("solve_ivp LSODA", "solve_ivp", {"method": "LSODA", "rtol": r}, "numpy")
+        for r in (1e-6, 1e-8)
+    ]
 )
 
 
@@ -116,8 +126,11 @@ def main() -> None:
         "rhs_evaluations_per_scene",
     )
     print(" ".join(f"{h:>14s}" for h in header))
-    for series, name, settings in CONFIGS:
-        simulation = pi.Simulation.from_names(integrator=name, integrator_settings=settings)
+    engine.set_threads(1)
+    for series, name, settings, path in CONFIGS:
+        simulation = pi.Simulation.from_names(
+            integrator=name, integrator_settings=settings, engine=path
+        )
         repeats = 2 if name == "solve_ivp" else 3
         result, per_scene = timed(simulation, batch, repeats)
         speed_error = np.abs(result.exit_speed - reference.exit_speed) / speed
@@ -146,6 +159,7 @@ def main() -> None:
         rows.append(row)
         print(" ".join(f"{x:>14.3g}" if isinstance(x, float) else f"{x!s:>14s}" for x in row))
 
+    engine.set_threads(0)
     RESULTS.mkdir(exist_ok=True)
     with open(RESULTS / "work_precision.csv", "w", newline="") as handle:
         writer = csv.writer(handle)
@@ -158,7 +172,8 @@ def main() -> None:
 
 
 def sweep_accuracy() -> None:
-    """The default's largest errors on the two 10,000-scene sweeps (module docstring)."""
+    """The default's largest errors on the two 10,000-scene sweeps (module docstring), on
+    each path."""
     sphere, plate = pi.presets.DEFAULT_SPHERE, pi.presets.plate("2024-T3/3.18")
     sweeps = {
         "throughput benchmark's 10,000 scenes": benchmark_batch(10_000, seed=10_000),
@@ -170,20 +185,24 @@ def sweep_accuracy() -> None:
         reference = pi.Simulation.from_names(
             integrator_settings={"rtol": REFERENCE_RTOL}
         ).run_batch(batch)
-        result = pi.Simulation.from_names().run_batch(batch)
-        flying = (reference.outcome != pi.Outcome.EMBEDMENT) & (
-            result.outcome != pi.Outcome.EMBEDMENT
-        )
-        speed_error = np.abs(result.exit_speed - reference.exit_speed) / batch.impact_speed
-        obliquity_error = np.degrees(np.abs(result.exit_obliquity - reference.exit_obliquity))
-        print(
-            f"default on {label}: outcome mismatches "
-            f"{int(np.sum(result.outcome != reference.outcome))}, max |Δ exit speed|/Vs "
-            f"{speed_error.max():.1e} (> 1e-6: {int(np.sum(speed_error > 1e-6))}), max |Δ exit "
-            f"obliquity| {obliquity_error[flying].max():.1e} deg (> 1e-4: "
-            f"{int(np.sum(obliquity_error[flying] > 1e-4))}), "
-            f"{result.stats['force_evaluations'] / batch.size:.1f} evaluations per scene"
-        )
+        for path in ("compiled", "numpy"):
+            result = pi.Simulation.from_names(engine=path).run_batch(batch)
+            _sweep_row(f"{label}, {path} path", batch, result, reference)
+
+
+def _sweep_row(label, batch, result, reference) -> None:
+    """One line: the default's largest errors against the reference on ``batch``."""
+    flying = (reference.outcome != pi.Outcome.EMBEDMENT) & (result.outcome != pi.Outcome.EMBEDMENT)
+    speed_error = np.abs(result.exit_speed - reference.exit_speed) / batch.impact_speed
+    obliquity_error = np.degrees(np.abs(result.exit_obliquity - reference.exit_obliquity))
+    print(
+        f"default on {label}: outcome mismatches "
+        f"{int(np.sum(result.outcome != reference.outcome))}, max |Δ exit speed|/Vs "
+        f"{speed_error.max():.1e} (> 1e-6: {int(np.sum(speed_error > 1e-6))}), max |Δ exit "
+        f"obliquity| {obliquity_error[flying].max():.1e} deg (> 1e-4: "
+        f"{int(np.sum(obliquity_error[flying] > 1e-4))}), "
+        f"{result.stats['force_evaluations'] / batch.size:.1f} evaluations per scene"
+    )
 
 
 def plot(rows: list[tuple], scenes: int) -> None:
@@ -191,7 +210,7 @@ def plot(rows: list[tuple], scenes: int) -> None:
     fig, axes = style.figure(1, 2, figsize=(12, 4.8))
     for series in dict.fromkeys(r[0] for r in rows):
         points = [r for r in rows if r[0] == series]
-        line = "s--" if "straddling" in series else "o-"
+        line = "s--" if "straddling" in series else ("D-" if "compiled" in series else "o-")
         for ax, column in zip(axes, (4, 6), strict=True):
             ax.loglog(
                 [max(float(r[column]), 1e-16) for r in points],
@@ -200,6 +219,7 @@ def plot(rows: list[tuple], scenes: int) -> None:
                 label=series,
             )
     axes[0].set_xlabel("max exit-speed error / impact speed")
+    axes[0].set_title("compiled and numpy dopri5: the same errors, not the same time", fontsize=9)
     axes[1].set_xlabel("max exit-obliquity error [deg]")
     for ax in axes:
         ax.set_ylabel("time per scene [s]")
