@@ -17,7 +17,7 @@ import pytest
 import plateimpact as pi
 from plateimpact.cli import main
 from plateimpact.solve.compiled import building, cache, program, warming
-from plateimpact.solve.driver import _warned, choose_engine
+from plateimpact.solve.driver import _cold, _warned, choose_engine
 from plateimpact_plugins.plugging import Plugging
 from plateimpact_plugins.poncelet import Poncelet
 
@@ -34,7 +34,9 @@ def cold_cache(tmp_path, monkeypatch):
         warming.subprocess, "Popen", lambda command, **kwargs: started.append(command)
     )
     _warned.clear()
-    return started
+    _cold.clear()
+    yield started
+    _cold.clear()
 
 
 def _model():
@@ -65,6 +67,16 @@ def test_a_program_being_compiled_is_not_started_again(cold_cache):
     assert len(cold_cache) == 1
 
 
+def test_a_process_keeps_the_numpy_path_for_a_pair_it_found_cold(cold_cache):
+    """One command's results never change path half-way when the compile finishes."""
+    model, integrator = _model()
+    assert choose_engine("auto", model, integrator, 10) == "numpy"
+    cache.mark(program.spec(Poncelet, Plugging).key)  # the detached compile finished
+    assert choose_engine("auto", model, integrator, 10) == "numpy"
+    assert choose_engine("compiled", model, integrator, 10) == "compiled"
+    assert len(cold_cache) == 1
+
+
 def test_a_ready_program_runs_compiled(cold_cache):
     model, integrator = _model()
     cache.mark(program.spec(Poncelet, Plugging).key)
@@ -81,7 +93,8 @@ def test_a_failed_program_runs_numpy_with_its_reason_once(cold_cache):
         assert choose_engine("auto", model, integrator, 10) == "numpy"
     assert len(said) == 1 and "\n" not in str(said[0].message)
     assert cold_cache == []  # a failure is not retried on every run
-    cache.mark(key)  # compiled since (e.g. by plateimpact compile)
+    cache.mark(key)  # compiled since (e.g. by plateimpact compile): the next process
+    _cold.clear()
     assert choose_engine("auto", model, integrator, 10) == "compiled"
 
 

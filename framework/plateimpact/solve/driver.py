@@ -45,6 +45,7 @@ COMPILED_MIN_SCENES = 1
 WARM_VARIABLE = "PLATEIMPACT_COMPILE"
 
 _warned: set[str] = set()
+_cold: set[tuple[type, type]] = set()  # pairs found not ready: numpy for this process
 
 
 def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, size: int) -> str:
@@ -54,7 +55,8 @@ def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, si
     missing or failing) runs on the numpy path, with one warning line per process where
     numba is missing or failed; so does a run whose compiled program is not ready yet,
     while a detached process compiles it (:mod:`.compiled.warming`: no run waits for
-    numba; ``plateimpact compile`` compiles every installed pair at once).
+    numba; ``plateimpact compile`` compiles every installed pair at once). A process
+    keeps the numpy path for a pair it found not ready.
     """
     if requested == "numpy" or (requested == "auto" and size < COMPILED_MIN_SCENES):
         return "numpy"
@@ -73,6 +75,8 @@ def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, si
         return "numpy"
     if requested == "compiled":
         return "compiled"
+    if (law, failure) in _cold:
+        return "numpy"
     try:
         program = cache.status(law, failure)
     except (ImportError, OSError) as exc:
@@ -80,6 +84,9 @@ def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, si
         return "numpy"
     if program.ready:
         return "compiled"
+    # Not ready: this process keeps the numpy path for the pair, so that one command's
+    # results do not change path when the compile finishes half-way through it.
+    _cold.add((law, failure))
     if program.failure:
         warn_once(program.failure)
     elif os.environ.get(WARM_VARIABLE, "background") != "off":
