@@ -8,6 +8,7 @@ waits for a process or a compile."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import warnings
@@ -52,10 +53,11 @@ def test_a_cold_program_runs_numpy_and_starts_one_compile(cold_cache):
     assert len(cold_cache) == 1
     command = cold_cache[0]
     assert command[:3] == [sys.executable, "-m", "plateimpact.solve.compiled.warming"]
-    assert command[3:] == [
+    assert command[3:5] == [
         "plateimpact_plugins.poncelet:Poncelet",
         "plateimpact_plugins.plugging:Plugging",
     ]
+    assert len(command) == 6 and command[5].isdigit()  # the pipe it waits on
 
 
 def test_a_program_being_compiled_is_not_started_again(cold_cache):
@@ -103,6 +105,24 @@ def test_compiling_can_be_switched_off(cold_cache, monkeypatch):
     model, integrator = _model()
     assert choose_engine("auto", model, integrator, 10) == "numpy"
     assert cold_cache == []
+
+
+def test_the_detached_process_waits_for_its_starter_to_end(tmp_path, monkeypatch):
+    """It compiles once the pipe's write end (held by the starter) is closed: here the
+    pipe is closed before, and the compile is recorded instead of run."""
+    monkeypatch.setenv("PLATEIMPACT_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(warming.os, "nice", lambda increment: 0)
+    compiled = []
+    monkeypatch.setattr(
+        warming, "compile_pairs", lambda pairs: compiled.append(pairs) or [("", "ready")]
+    )
+    waited, held = os.pipe()
+    os.write(held, b"x")  # bytes before the end are read and ignored
+    os.close(held)
+    names = ["plateimpact_plugins.poncelet:Poncelet", "plateimpact_plugins.plugging:Plugging"]
+    assert warming.main([*names, str(waited)]) == 0
+    os.close(waited)
+    assert compiled == [[(Poncelet, Plugging)]]
 
 
 def test_the_detached_process_refuses_bad_arguments():
