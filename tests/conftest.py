@@ -38,6 +38,9 @@ def _scale_time_limits() -> float:
 
 
 SCALE = _scale_time_limits()
+#: No test starts a detached compile ("auto" runs a pair whose program is not in the cache
+#: on the numpy path); tests/test_warming.py tests that start with Popen recorded.
+os.environ["PLATEIMPACT_COMPILE"] = "off"
 
 
 def pytest_report_header() -> str:
