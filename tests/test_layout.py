@@ -31,7 +31,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("run",),  # simulations, variants, progress
     ("storage",),  # archives, netCDF, locks, plate and shot files, outputs, export
     ("provenance",),  # what produced a result: inputs, versions, the code's hashes
-    ("study", "limits", "v50", "calibration", "experiment", "comparison"),  # analysis
+    ("study", "limits", "v50", "calibration", "experiment", "comparison", "uncertainty"),
     ("figures",),  # every figure
     ("cli",),  # the command line
 ]

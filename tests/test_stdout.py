@@ -88,6 +88,11 @@ def commands(archive: Path, tmp: Path) -> list[list[str]]:
     # reproduce's: the session's quick report resumed, so that the command prints its
     # whole report after drawing its figures again, without running its studies again
     report = shutil.copytree(archive.parent, tmp / "r")
+    spec = tmp / "spec.json"
+    spec.write_text(
+        '{"preset": "2024-T3/3.18", "at": {"speed_m_s": 400, "obliquity_deg": 0}, '
+        '"inputs": {"speed_m_s": {"normal": {"mean": 400, "sd": 15}}}, "samples": 50}'
+    )
     return [
         ["--version"],
         ["--help"],
@@ -117,6 +122,7 @@ def commands(archive: Path, tmp: Path) -> list[list[str]]:
         ["upgrade", str(old)],
         ["reproduce", "--quick", "--resume", "--out", str(report), "--dpi", "50"],
         ["compile"],
+        ["uncertainty", str(spec)],
     ]  # fmt: skip
 
 

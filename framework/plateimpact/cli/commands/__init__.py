@@ -53,6 +53,12 @@ COMMANDS = (
         "V50 of go/no-go shots: probit or logit fit with confidence intervals, or the "
         "MIL-STD-662F estimate",
     ),
+    Command(
+        "uncertainty",
+        "uncertainty",
+        "distributions on the inputs, propagated: the probability of each outcome with its "
+        "confidence interval",
+    ),
     Command("reproduce", "reproduce", "run the report's figure families into one archive"),
     Command(
         "compile",

@@ -1,0 +1,201 @@
+"""Uncertainty propagation (docs/uncertainty.md) against closed forms: the probability of
+perforation at normal incidence with only the impact speed uncertain is P(Vs > V_bl) for
+the ballistic limit's closed form; the sampling methods' marginals are their
+distributions (stratified for Latin hypercube and Sobol' points); a spec's bad value is
+one line naming its key; a seeded study is the same bits twice."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+from test_limits import swept_volume
+
+import plateimpact as pi
+from plateimpact import presets
+from plateimpact.cli import main
+from plateimpact.model.impact import REST_SPEED_FRACTION
+from plateimpact.uncertainty import (
+    LogNormal,
+    Normal,
+    TruncatedNormal,
+    Uniform,
+    propagate,
+    read_spec,
+)
+from plateimpact.uncertainty.propagation import scenes, unit_samples
+from plateimpact.uncertainty.spec import UncertaintySpecError
+
+PRESET = "2024-T3/3.18"
+SPHERE = presets.DEFAULT_SPHERE
+
+
+@pytest.fixture(scope="module")
+def registry():
+    return pi.default_registry()
+
+
+def closed_form_ballistic_limit(plate: pi.Plate) -> float:
+    """V_bl at normal incidence with plugging: a + b Vr² = (a + b Vs²) e^{−2bW/m} with the
+    rest speed f Vs as the least residual speed (tests/test_limits.py)."""
+    a, b, m = plate.a, plate.b, SPHERE.mass
+    f = REST_SPEED_FRACTION.default
+    r2 = math.exp(-2 * b * swept_volume(plate) / m)
+    return math.sqrt(a * (1 - r2) / (b * (r2 - f * f)))
+
+
+def speed_only(mean: float, sd: float, method: str, samples: int, seed: int = 3) -> dict:
+    return {
+        "preset": PRESET,
+        "failure": "plugging",
+        "at": {"obliquity_deg": 0.0},
+        "inputs": {"speed_m_s": {"normal": {"mean": mean, "sd": sd}}},
+        "samples": samples,
+        "method": method,
+        "seed": seed,
+    }
+
+
+@pytest.mark.parametrize("method", ["mc", "sobol"])
+@pytest.mark.parametrize("offset", [-1.0, 0.0, 0.6])
+def test_perforation_probability_is_that_of_the_closed_form_limit(registry, method, offset):
+    """P(perforation) = 1 − Φ((V_bl − μ)/σ), inside the study's interval (at 99.9%, so
+    that the check does not depend on the seed's luck: 6 cases fail together with
+    probability under 1%)."""
+    limit = closed_form_ballistic_limit(presets.plate(PRESET))
+    sd = 20.0
+    mean = limit + offset * sd
+    spec = read_spec(speed_only(mean, sd, method, 4096), registry)
+    found = propagate(spec, registry, confidence=0.999)
+    exact = 1.0 - stats.norm.cdf((limit - mean) / sd)
+    low, high = found.intervals()["perforation"]
+    assert low <= exact <= high, (exact, low, high)
+    assert found.counts["ricochet"] == 0  # normal incidence never turns back
+    assert found.counts["embedment"] + found.counts["perforation"] == 4096
+
+
+@pytest.mark.parametrize("method", ["lhs", "sobol"])
+def test_stratified_points_fill_every_stratum_once(method):
+    """n = 2^10 points: each of the n equal strata of every coordinate holds exactly one
+    (a Latin hypercube by construction; a scrambled Sobol' net of 2^m points too), so
+    the empirical distribution is within 1/n of the uniform one."""
+    n = 1024
+    points = unit_samples(method, n, 3, seed=11)
+    for column in points.T:
+        assert np.array_equal(np.sort(np.floor(column * n)), np.arange(n))
+
+
+def test_independent_draws_pass_a_uniformity_test():
+    points = unit_samples("mc", 5000, 2, seed=11)
+    for column in points.T:
+        assert stats.kstest(column, "uniform").statistic < 1.63 / math.sqrt(5000)  # 99%
+
+
+@pytest.mark.parametrize(
+    "distribution, median, inside",
+    [
+        (Normal(10.0, 2.0), 10.0, (-np.inf, np.inf)),
+        (LogNormal(3.0, 0.5), 3.0, (0.0, np.inf)),
+        (Uniform(1.0, 5.0), 3.0, (1.0, 5.0)),
+        (TruncatedNormal(0.0, 1.0, -0.5, 2.0), None, (-0.5, 2.0)),
+    ],
+)
+def test_each_distribution_maps_probabilities_to_values(distribution, median, inside):
+    u = np.linspace(0.001, 0.999, 999)
+    values = distribution.ppf(u)
+    assert np.all(np.diff(values) > 0) and inside[0] <= values[0] and values[-1] <= inside[1]
+    if median is not None:
+        assert distribution.ppf(np.array([0.5]))[0] == pytest.approx(median, rel=1e-12)
+    for x, p in zip(values[::100], u[::100], strict=True):  # cdf inverts ppf
+        assert distribution.cdf(float(x)) == pytest.approx(p, abs=1e-9)
+
+
+def test_a_seeded_study_is_the_same_bits_twice(registry):
+    given = speed_only(600.0, 30.0, "lhs", 500, seed=9)
+    given["inputs"]["pstar_mm"] = {"uniform": {"low": 2.0, "high": 4.0}}
+    first = propagate(read_spec(given, registry), registry)
+    second = propagate(read_spec(given, registry), registry)
+    for name in first.inputs:
+        assert np.array_equal(first.inputs[name], second.inputs[name])
+    assert np.array_equal(first.result.outcome, second.result.outcome)
+    assert np.array_equal(first.result.exit_speed, second.result.exit_speed)
+    given["seed"] = 10
+    other = propagate(read_spec(given, registry), registry)
+    assert not np.array_equal(first.inputs["speed_m_s"], other.inputs["speed_m_s"])
+
+
+def test_sampled_values_set_their_columns(registry):
+    """P* in mm and the speed in m/s reach the scenes in SI."""
+    given = speed_only(600.0, 30.0, "mc", 200)
+    given["inputs"]["pstar_mm"] = {"uniform": {"low": 2.0, "high": 4.0}}
+    found = propagate(read_spec(given, registry), registry)
+    batch = scenes(found.spec, found.inputs, registry)
+    assert np.array_equal(batch.columns["critical_penetration"], found.inputs["pstar_mm"] * 1e-3)
+    assert np.array_equal(batch.columns["impact_speed"], found.inputs["speed_m_s"])
+    assert np.all(batch.columns["impact_obliquity"] == 0.0)
+
+
+@pytest.mark.parametrize(
+    "change, said",
+    [
+        ({"inputs": {"pstar_mm": {"normal": {"mean": 0.5, "sd": 1.0}}}}, "inputs.pstar_mm"),
+        ({"inputs": {"obliquity_deg": {"uniform": {"low": 10, "high": 95}}}}, "[0, 90) deg"),
+        ({"inputs": {"speed_m_s": {"gamma": {"k": 2}}}}, "unknown distribution"),
+        ({"inputs": {"speed_m_s": {"normal": {"mean": 400}}}}, "takes exactly mean, sd"),
+        ({"inputs": {"speed_m_s": {"normal": {"mean": 400, "sd": -1}}}}, "sd must be > 0"),
+        ({"inputs": {"speed_m_s": {"normal": {"mean": "fast", "sd": 1}}}}, "a number is needed"),
+        ({"inputs": {"sped_m_s": {"fixed": {"value": 1}}}}, "sped_m_s: unknown input"),
+        ({"at": {"obliquity_deg": 91}}, "at.obliquity_deg"),
+        ({"samples": 1}, "samples: an integer"),
+        ({"method": "halton"}, "method: one of mc, sobol, lhs"),
+        ({"seed": -1}, "seed: an integer"),
+        ({"preset": "unobtainium"}, "preset: one of"),
+        ({"extra": 1}, "unknown key 'extra'"),
+    ],
+)
+def test_a_bad_spec_is_one_line_naming_its_key(registry, change, said):
+    given = speed_only(400.0, 15.0, "mc", 100)
+    given.update(change)
+    with pytest.raises(UncertaintySpecError, match=None) as raised:
+        read_spec(given, registry)
+    message = str(raised.value)
+    assert said in message and "\n" not in message
+
+
+def test_a_truncated_normal_inside_the_range_is_accepted(registry):
+    given = speed_only(400.0, 15.0, "mc", 100)
+    given["inputs"]["pstar_mm"] = {"truncnormal": {"mean": 0.5, "sd": 1.0, "low": 0.01, "high": 3}}
+    spec = read_spec(given, registry)
+    found = propagate(spec, registry)
+    assert 0.01 <= found.inputs["pstar_mm"].min() and found.inputs["pstar_mm"].max() <= 3.0
+
+
+def test_the_command_prints_probabilities_and_intervals(tmp_path, capsys):
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(speed_only(400.0, 15.0, "mc", 300)))
+    assert main(["uncertainty", str(path), "--json", "--samples", "256", "--method", "sobol"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["samples"] == 256 and said["method"] == "sobol"
+    assert (
+        set(said["probabilities"])
+        == set(said["intervals"])
+        == {
+            "ricochet",
+            "embedment",
+            "perforation",
+        }
+    )
+    assert sum(said["probabilities"].values()) == pytest.approx(1.0)
+    for name, (low, high) in said["intervals"].items():
+        assert low <= said["probabilities"][name] <= high
+
+
+def test_the_command_refuses_a_bad_spec_in_one_line(tmp_path, capsys):
+    path = tmp_path / "spec.json"
+    path.write_text('{"preset": "2024-T3/3.18", "at": {"speed_m_s": 400}}')
+    assert main(["uncertainty", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "obliquity_deg: give it in at or in inputs" in err
