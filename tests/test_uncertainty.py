@@ -26,6 +26,7 @@ from plateimpact.uncertainty import (
     propagate,
     read_spec,
 )
+from plateimpact.uncertainty.limits import sampled_limits
 from plateimpact.uncertainty.propagation import scenes, unit_samples
 from plateimpact.uncertainty.spec import UncertaintySpecError
 
@@ -199,3 +200,73 @@ def test_the_command_refuses_a_bad_spec_in_one_line(tmp_path, capsys):
     assert main(["uncertainty", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "obliquity_deg: give it in at or in inputs" in err
+
+
+def pstar_only(samples: int, seed: int = 4) -> dict:
+    return {
+        "preset": PRESET,
+        "failure": "plugging",
+        "at": {"obliquity_deg": 0.0},
+        "inputs": {"pstar_mm": {"uniform": {"low": 2.5, "high": 3.5}}},
+        "samples": samples,
+        "seed": seed,
+    }
+
+
+@pytest.fixture(scope="module")
+def sampled(registry):
+    return sampled_limits(read_spec(pstar_only(120), registry), registry, 0.0)
+
+
+def test_each_sampled_limit_is_its_plates_closed_form(sampled):
+    """With only P* uncertain at normal incidence, every sample's ballistic limit is the
+    closed form for its P*, to the finder's tolerance."""
+    plate = presets.plate(PRESET)
+    for pstar_mm, found in zip(sampled.inputs["pstar_mm"], sampled.ballistic, strict=True):
+        constants = {**dict(plate.constants), "critical_penetration": pstar_mm * 1e-3}
+        own = pi.Plate(plate.material, plate.thickness, tuple(constants.items()))
+        assert found == pytest.approx(
+            closed_form_ballistic_limit(own), abs=sampled.tolerance / 2 + 1e-6
+        )
+
+
+@pytest.mark.parametrize("speed", [360.0, 395.0, 430.0])
+def test_the_curve_from_sampled_limits_is_per_speed_monte_carlo(registry, sampled, speed):
+    """P(perforation | V) read off the sampled limits counts the same samples as running
+    each sample at V (the same seed draws the same P*), except a sample whose limit lies
+    within the finder's tolerance of V."""
+    given = pstar_only(120)
+    given["at"]["speed_m_s"] = speed
+    direct = propagate(read_spec(given, registry), registry)
+    assert np.array_equal(direct.inputs["pstar_mm"], sampled.inputs["pstar_mm"])
+    perforated = direct.result.outcome == pi.Outcome.PERFORATION
+    below = sampled.ballistic < speed
+    close = np.abs(sampled.ballistic - speed) <= sampled.tolerance
+    assert np.array_equal(perforated[~close], below[~close])
+    probability, low, high = sampled.perforation_curve(np.array([speed]))
+    assert low[0] <= direct.probabilities()["perforation"] <= high[0]
+    assert probability[0] == pytest.approx(np.mean(below))
+
+
+def test_quantiles_of_the_limit_bracket_the_sample_quantile(sampled):
+    v50 = sampled.quantile(0.5)
+    assert v50["low_m_s"] <= v50["speed_m_s"] <= v50["high_m_s"]
+    assert v50["speed_m_s"] == np.quantile(sampled.ballistic, 0.5, method="inverted_cdf")
+    v10, v90 = sampled.quantile(0.1), sampled.quantile(0.9)
+    assert v10["speed_m_s"] < v50["speed_m_s"] < v90["speed_m_s"]
+
+
+def test_the_limit_refuses_an_uncertain_speed(registry):
+    spec = read_spec(speed_only(400.0, 15.0, "mc", 10), registry)
+    with pytest.raises(pi.ParameterError, match="give speed_m_s no distribution"):
+        sampled_limits(spec, registry, 0.0)
+
+
+def test_the_command_prints_the_limits_quantiles(tmp_path, capsys):
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(pstar_only(40)))
+    assert main(["uncertainty", str(path), "--limits", "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["samples"] == 40 and said["obliquity_deg"] == 0.0
+    assert said["V10"]["speed_m_s"] < said["V50"]["speed_m_s"] < said["V90"]["speed_m_s"]
+    assert said["spec"]["inputs"] == {"pstar_mm": {"uniform": {"low": 2.5, "high": 3.5}}}

@@ -19,7 +19,7 @@ from ..model.results import BatchResult, Outcome
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from .inputs import input_table
-from .spec import UncertaintySpec
+from .spec import UncertaintySpec, UncertaintySpecError
 
 #: The outcomes whose probabilities are reported, by their names in outputs.
 OUTCOMES = {"ricochet": Outcome.RICOCHET, "embedment": Outcome.EMBEDMENT,
@@ -153,6 +153,10 @@ def propagate(
 ) -> Propagation:
     """Sample ``spec``'s inputs and run one scene per sample (``simulation``: the spec's
     failure model with the registry's defaults otherwise)."""
+    if "speed_m_s" not in spec.at and "speed_m_s" not in spec.inputs:
+        raise UncertaintySpecError(
+            f"{spec.source}: speed_m_s: give it in at or in inputs (or ask for the limits)"
+        )
     if simulation is None:
         simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     inputs = sample_inputs(spec)

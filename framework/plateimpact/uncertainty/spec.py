@@ -181,9 +181,8 @@ def read_spec(
         name: _distribution(name, given, table[name], what)
         for name, given in sections["inputs"].items()
     }
-    for needed in ("speed_m_s", "obliquity_deg"):
-        if needed not in at and needed not in inputs:
-            raise UncertaintySpecError(f"{what}: {needed}: give it in at or in inputs")
+    if "obliquity_deg" not in at and "obliquity_deg" not in inputs:
+        raise UncertaintySpecError(f"{what}: obliquity_deg: give it in at or in inputs")
     settings = {"samples": 10_000, "method": "mc", "seed": 0}
     for key in settings:
         if key in data:
