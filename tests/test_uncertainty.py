@@ -28,6 +28,7 @@ from plateimpact.uncertainty import (
 )
 from plateimpact.uncertainty.limits import sampled_limits
 from plateimpact.uncertainty.propagation import scenes, unit_samples
+from plateimpact.uncertainty.sensitivity import perforation_indices, sobol_indices
 from plateimpact.uncertainty.spec import UncertaintySpecError
 
 PRESET = "2024-T3/3.18"
@@ -270,3 +271,71 @@ def test_the_command_prints_the_limits_quantiles(tmp_path, capsys):
     assert said["samples"] == 40 and said["obliquity_deg"] == 0.0
     assert said["V10"]["speed_m_s"] < said["V50"]["speed_m_s"] < said["V90"]["speed_m_s"]
     assert said["spec"]["inputs"] == {"pstar_mm": {"uniform": {"low": 2.5, "high": 3.5}}}
+
+
+def ishigami(values: dict[str, np.ndarray], a: float = 7.0, b: float = 0.1) -> np.ndarray:
+    x1, x2, x3 = values["x1"], values["x2"], values["x3"]
+    return np.sin(x1) + a * np.sin(x2) ** 2 + b * x3**4 * np.sin(x1)
+
+
+def test_sobol_indices_of_the_ishigami_function_are_its_analytical_ones():
+    """S1 = (0.314, 0.442, 0), ST = (0.558, 0.442, 0.244) for a = 7, b = 0.1 (Ishigami
+    and Homma 1990; Sobol' and Levitan 1999), inside the 99% bootstrap intervals."""
+    a, b, pi4 = 7.0, 0.1, np.pi**4
+    variance = a**2 / 8 + b * pi4 / 5 + b**2 * pi4**2 / 18 + 0.5
+    v1, v2, v13 = 0.5 * (1 + b * pi4 / 5) ** 2, a**2 / 8, 8 * b**2 * pi4**2 / 225
+    first = np.array([v1, v2, 0.0]) / variance
+    total = np.array([v1 + v13, v2, v13]) / variance
+    inputs = {name: Uniform(-np.pi, np.pi) for name in ("x1", "x2", "x3")}
+    found = sobol_indices(inputs, ishigami, 2**13, seed=5, confidence=0.99)
+    assert found.evaluations == 2**13 * 5
+    assert np.all(np.abs(found.first - first) <= found.first_halfwidth)
+    assert np.all(np.abs(found.total - total) <= found.total_halfwidth)
+    assert found.dominant() == "x1"
+
+
+def test_perforation_indices_on_the_model_are_variance_shares(registry):
+    """On the model, the first-order indices of whether a sample perforates sum to at
+    most 1 and no total index is below its first-order one (to their intervals); at
+    normal incidence the speed's spread of 30 m/s outweighs P*'s ± 0.1 mm."""
+    given = {
+        "preset": PRESET,
+        "failure": "plugging",
+        "at": {"obliquity_deg": 0.0},
+        "inputs": {
+            "speed_m_s": {"normal": {"mean": 392.0, "sd": 30.0}},
+            "pstar_mm": {"uniform": {"low": 2.9, "high": 3.1}},
+        },
+        "seed": 3,
+    }
+    found = perforation_indices(read_spec(given, registry), registry, 2**9)
+    assert found.first.sum() <= 1.0 + found.first_halfwidth.sum()
+    assert np.all(found.total >= found.first - found.first_halfwidth - found.total_halfwidth)
+    assert found.dominant() == "speed_m_s"
+
+
+def test_the_command_prints_sobol_indices_and_draws_their_bars(tmp_path, capsys):
+    given = speed_only(392.0, 30.0, "mc", 100)
+    given["inputs"]["pstar_mm"] = {"uniform": {"low": 2.9, "high": 3.1}}
+    path, png = tmp_path / "spec.json", tmp_path / "bars.png"
+    path.write_text(json.dumps(given))
+    argv = ["uncertainty", str(path), "--sobol", "64", "--png", str(png), "--dpi", "50", "--json"]
+    assert main(argv) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["evaluations"] == 64 * 4 and set(said["indices"]) == {"speed_m_s", "pstar_mm"}
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    "extra, said",
+    [
+        (["--sobol", "100"], "--sobol: a power of 2"),
+        (["--png", "x.png"], "--png draws the Sobol' indices: give --sobol N too"),
+    ],
+)
+def test_the_command_refuses_bad_sobol_flags_in_one_line(tmp_path, capsys, extra, said):
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(speed_only(392.0, 30.0, "mc", 100)))
+    assert main(["uncertainty", str(path), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and said in err

@@ -11,6 +11,7 @@ from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
 from ...uncertainty import propagate, read_spec
 from ...uncertainty.limits import sampled_limits
+from ...uncertainty.sensitivity import perforation_indices
 from ...uncertainty.spec import (
     MAX_SAMPLES,
     METHODS,
@@ -18,6 +19,7 @@ from ...uncertainty.spec import (
     UncertaintySpecError,
     with_settings,
 )
+from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
 from ..writer import Writer
 
 
@@ -41,7 +43,17 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
         "(the speed takes no distribution): V10, V50 and V90 with distribution-free 95%% "
         "intervals, the whole P(perforation | V) curve from one set of limits",
     )
+    p.add_argument(
+        "--sobol",
+        type=int,
+        metavar="N",
+        help="instead: Sobol' first-order and total indices of perforation at the spec's "
+        "condition to each uncertain input, from N x (inputs + 2) runs (N a power of 2, "
+        "in [16, 1,048,576])",
+    )
+    p.add_argument("--png", metavar="FILE", help="with --sobol: draw the indices as bars")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_dpi_option(p)
 
 
 def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
@@ -54,6 +66,11 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         method=spec.method if args.method is None else args.method,
         seed=spec.seed if args.seed is None else args.seed,
     )
+    if args.png is not None and args.sobol is None:
+        raise UsageError("--png draws the Sobol' indices: give --sobol N too")
+    check_directory(args.png, "--png", "figure")
+    if args.sobol is not None:
+        return _sobol(spec, registry, args, out)
     if args.limits:
         return _limits(spec, registry, args.json, out)
     with reporting_scenes("uncertainty", spec.samples):
@@ -104,4 +121,36 @@ def _limits(spec: UncertaintySpec, registry: PluginRegistry, as_json: bool, out:
     beyond, below = summary["beyond_range"], summary["below_range"]
     if beyond or below:
         out.say(f"  {beyond} sample(s) never perforate in the range, {below} always do")
+    return 0
+
+
+def _sobol(
+    spec: UncertaintySpec, registry: PluginRegistry, args: argparse.Namespace, out: Writer
+) -> int:
+    base = args.sobol
+    if not (16 <= base <= 2**20 and base & (base - 1) == 0):
+        raise UsageError(f"--sobol: a power of 2 in [16, {2**20:,}], got {base}")
+    if len(spec.inputs) < 2:
+        raise UncertaintySpecError(f"{spec.source}: inputs: --sobol needs two or more")
+    with reporting_scenes("uncertainty --sobol", base * (len(spec.inputs) + 2)):
+        found = perforation_indices(spec, registry, base)
+    if args.png is not None:
+        from ...figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
+
+        title = f"{spec.plate.material}, {spec.plate.thickness * 1e3:g} mm: perforation"
+        save_figure_atomically(plot_sobol_indices(found, title), args.png, dpi=args.dpi)
+    summary = {**found.to_json(), "spec": spec.describe()}
+    if args.json:
+        out.say(json.dumps(summary, indent=2))
+        return 0
+    out.say(f"{spec.source}: Sobol' indices of perforation, {found.evaluations:,} runs")
+    for name, index in summary["indices"].items():
+        first, total = index["first_interval"], index["total_interval"]
+        out.say(
+            f"  {name:14s} S1 {index['first']:6.3f} [{first[0]:6.3f}, {first[1]:6.3f}]   "
+            f"ST {index['total']:6.3f} [{total[0]:6.3f}, {total[1]:6.3f}]"
+        )
+    out.say(f"  dominant: {found.dominant()}")
+    if args.png is not None:
+        out.say(f"figure: {args.png}")
     return 0
