@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from ...model.bodies import THICKNESS
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
 from ...uncertainty import propagate, read_spec
@@ -20,6 +21,7 @@ from ...uncertainty.spec import (
     with_settings,
 )
 from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
+from ..formatting import quantity
 from ..writer import Writer
 
 
@@ -137,7 +139,8 @@ def _sobol(
     if args.png is not None:
         from ...figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
 
-        title = f"{spec.plate.material}, {spec.plate.thickness * 1e3:g} mm: perforation"
+        thickness = quantity(THICKNESS, spec.plate.thickness, 3)
+        title = f"{spec.plate.material}, {thickness}: perforation"
         save_figure_atomically(plot_sobol_indices(found, title), args.png, dpi=args.dpi)
     summary = {**found.to_json(), "spec": spec.describe()}
     if args.json:
