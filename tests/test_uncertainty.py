@@ -27,7 +27,7 @@ from plateimpact.uncertainty import (
     read_spec,
 )
 from plateimpact.uncertainty.limits import sampled_limits
-from plateimpact.uncertainty.propagation import scenes, unit_samples
+from plateimpact.uncertainty.propagation import sample_inputs, scenes, unit_samples
 from plateimpact.uncertainty.sensitivity import perforation_indices, sobol_indices
 from plateimpact.uncertainty.spec import UncertaintySpecError
 
@@ -339,3 +339,76 @@ def test_the_command_refuses_bad_sobol_flags_in_one_line(tmp_path, capsys, extra
     assert main(["uncertainty", str(path), *extra]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and said in err
+
+
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    """A plate file as calibrate --out writes it, from the studies' 2024-T3 shots."""
+    from pathlib import Path
+
+    shots = Path(__file__).resolve().parents[1] / "studies" / "data" / "shots_2024T3_3.18mm.csv"
+    out = tmp_path_factory.mktemp("calibrated") / "cal.json"
+    assert main(["calibrate", str(shots), "--preset", PRESET, "--out", str(out)]) == 0
+    return out
+
+
+def test_a_calibration_file_gives_a_and_b_their_joint_normal(registry, calibrated):
+    """a and b are normal with the file's values and standard errors, correlated as its
+    ab_correlation says (a Gaussian copula of normal marginals: exactly a bivariate
+    normal): the sample moments within a few standard errors of 20,000 draws."""
+    written = json.loads(calibrated.read_text())
+    block = written["calibration"]
+    given = {
+        "plate_file": calibrated.name,
+        "calibration_file": calibrated.name,
+        "at": {"speed_m_s": 400.0, "obliquity_deg": 0.0},
+        "samples": 20_000,
+        "seed": 2,
+    }
+    spec_path = calibrated.parent / "spec.json"
+    spec_path.write_text(json.dumps(given))
+    spec = read_spec(spec_path, registry)
+    assert spec.correlations == (("a_N_m2", "b_kg_m3", block["ab_correlation"]),)
+    values = sample_inputs(spec)
+    a, b = values["a_N_m2"], values["b_kg_m3"]
+    rho = block["ab_correlation"]
+    assert -1 < rho < 0  # a stronger plate fits with a lighter inertial term
+    assert np.corrcoef(a, b)[0, 1] == pytest.approx(rho, abs=5 * (1 - rho**2) / math.sqrt(a.size))
+    assert a.mean() == pytest.approx(written["a_N_m2"], abs=5 * block["a_stderr_N_m2"] / 141)
+    assert a.std() == pytest.approx(block["a_stderr_N_m2"], rel=0.05)
+    assert b.std() == pytest.approx(block["b_stderr_kg_m3"], rel=0.05)
+
+
+@pytest.mark.parametrize(
+    "correlations, said",
+    [
+        ([["speed_m_s", "pstar_mm", 1.2]], "rho in (-1, 1)"),
+        ([["speed_m_s", "pstar_mm", 0.5], ["pstar_mm", "speed_m_s", 0.1]], "appears twice"),
+        ([["speed_m_s", "a_N_m2", 0.5]], "a_N_m2 has no distribution"),
+        (
+            [
+                ["speed_m_s", "pstar_mm", 0.9],
+                ["speed_m_s", "b_kg_m3", 0.9],
+                ["pstar_mm", "b_kg_m3", -0.9],
+            ],
+            "not positive definite",
+        ),  # fmt: skip
+        ({"speed_m_s": 1}, "a list of [input, input, rho]"),
+    ],
+)
+def test_bad_correlations_are_one_line(registry, correlations, said):
+    given = speed_only(400.0, 15.0, "mc", 100)
+    given["inputs"]["pstar_mm"] = {"uniform": {"low": 2.5, "high": 3.5}}
+    given["inputs"]["b_kg_m3"] = {"uniform": {"low": 1000, "high": 1500}}
+    given["correlations"] = correlations
+    with pytest.raises(UncertaintySpecError) as raised:
+        read_spec(given, registry)
+    assert said in str(raised.value) and "\n" not in str(raised.value)
+
+
+def test_sobol_indices_refuse_correlated_inputs(registry):
+    given = speed_only(400.0, 15.0, "mc", 100)
+    given["inputs"]["pstar_mm"] = {"uniform": {"low": 2.5, "high": 3.5}}
+    given["correlations"] = [["speed_m_s", "pstar_mm", 0.3]]
+    with pytest.raises(UncertaintySpecError, match="need independent inputs"):
+        perforation_indices(read_spec(given, registry), registry, 16)

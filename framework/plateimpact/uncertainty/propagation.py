@@ -19,7 +19,7 @@ from ..model.results import BatchResult, Outcome
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from .inputs import input_table
-from .spec import UncertaintySpec, UncertaintySpecError
+from .spec import UncertaintySpec, UncertaintySpecError, correlation_matrix
 
 #: The outcomes whose probabilities are reported, by their names in outputs.
 OUTCOMES = {"ricochet": Outcome.RICOCHET, "embedment": Outcome.EMBEDMENT,
@@ -114,6 +114,13 @@ def sample_inputs(spec: UncertaintySpec) -> dict[str, np.ndarray]:
     names = list(spec.inputs)
     points = unit_samples(spec.method, spec.samples, len(names), spec.seed)
     points = np.clip(points, EDGE, 1.0 - EDGE)
+    if spec.correlations:
+        # A Gaussian copula: the points' normal scores correlated by the matrix's Cholesky
+        # factor, back to probabilities (the inputs' normal scores then have these
+        # correlations: the Pearson correlations of normal inputs).
+        factor = np.linalg.cholesky(correlation_matrix(spec.correlations, names))
+        scores = stats.norm.ppf(points) @ factor.T
+        points = np.clip(stats.norm.cdf(scores), EDGE, 1.0 - EDGE)
     return {name: spec.inputs[name].ppf(points[:, j]) for j, name in enumerate(names)}
 
 

@@ -21,7 +21,7 @@ from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from .distributions import Distribution
 from .propagation import EDGE, scenes
-from .spec import UncertaintySpec
+from .spec import UncertaintySpec, UncertaintySpecError
 
 Quantity = Callable[[dict[str, np.ndarray]], np.ndarray]
 
@@ -115,6 +115,10 @@ def perforation_indices(
 ) -> SobolIndices:
     """Sobol' indices of whether a sample perforates (its mean is P(perforation)) at the
     spec's condition, to each of the spec's uncertain inputs."""
+    if spec.correlations:
+        raise UncertaintySpecError(
+            f"{spec.source}: correlations: Sobol' indices need independent inputs"
+        )
     if simulation is None:
         simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     run = simulation

@@ -21,12 +21,13 @@ from pathlib import Path
 from typing import Any
 
 import attrs
+import numpy as np
 
 from ..base.errors import PlateImpactError
 from ..base.untrusted import load_json_file, printable
 from ..model.bodies import Plate
 from ..registry.plugin_registry import PluginRegistry
-from .distributions import KINDS, Distribution
+from .distributions import KINDS, Distribution, Normal
 from .inputs import UncertainInput, input_table
 
 #: The methods of sampling: independent draws, scrambled Sobol' points, Latin hypercube.
@@ -36,7 +37,8 @@ METHODS = ("mc", "sobol", "lhs")
 MAX_OUTSIDE = 1e-12
 #: The most samples a study draws (10⁷ scenes are some minutes on two cores).
 MAX_SAMPLES = 10_000_000
-KEYS = ("preset", "plate_file", "failure", "at", "inputs", "samples", "method", "seed")
+KEYS = ("preset", "plate_file", "failure", "at", "inputs", "correlations", "calibration_file",
+        "samples", "method", "seed")  # fmt: skip
 
 
 class UncertaintySpecError(PlateImpactError, ValueError):
@@ -54,6 +56,7 @@ class UncertaintySpec:
     failure: str | None
     at: dict[str, float]
     inputs: dict[str, Distribution]
+    correlations: tuple[tuple[str, str, float], ...] = ()
     samples: int = 10_000
     method: str = "mc"
     seed: int = 0
@@ -66,6 +69,7 @@ class UncertaintySpec:
             "failure": self.failure,
             "at": dict(self.at),
             "inputs": {name: d.describe() for name, d in self.inputs.items()},
+            "correlations": [list(c) for c in self.correlations],
             "samples": self.samples,
             "method": self.method,
             "seed": self.seed,
@@ -181,6 +185,24 @@ def read_spec(
         name: _distribution(name, given, table[name], what)
         for name, given in sections["inputs"].items()
     }
+    correlations = list(_correlation_list(data.get("correlations", []), what))
+    if "calibration_file" in data:
+        base = Path(os.fspath(source)).parent if not isinstance(source, dict) else Path()
+        a_b, correlation = _calibrated_ab(data["calibration_file"], base, what)
+        clash = sorted(set(a_b) & set(inputs))
+        if clash:
+            raise UncertaintySpecError(
+                f"{what}: inputs.{clash[0]}: the calibration_file gives it already"
+            )
+        inputs.update(a_b)
+        correlations.append(("a_N_m2", "b_kg_m3", correlation))
+    for first, second, _ in correlations:
+        for name in (first, second):
+            if name not in inputs:
+                raise UncertaintySpecError(
+                    f"{what}: correlations: {printable(name, 40)} has no distribution in inputs"
+                )
+    check_correlations(correlations, list(inputs), what)
     if "obliquity_deg" not in at and "obliquity_deg" not in inputs:
         raise UncertaintySpecError(f"{what}: obliquity_deg: give it in at or in inputs")
     settings = {"samples": 10_000, "method": "mc", "seed": 0}
@@ -188,7 +210,7 @@ def read_spec(
         if key in data:
             settings[key] = data[key]
     return with_settings(
-        UncertaintySpec(plate, failure, at, inputs, source=what),
+        UncertaintySpec(plate, failure, at, inputs, tuple(correlations), source=what),
         what,
         samples=settings["samples"],
         method=settings["method"],
@@ -208,3 +230,72 @@ def with_settings(
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
         raise UncertaintySpecError(f"{what}: seed: an integer in [0, 2**63)")
     return attrs.evolve(spec, samples=samples, method=method, seed=seed)
+
+
+def _correlation_list(given: Any, what: str) -> list[tuple[str, str, float]]:
+    """``[[name, name, ρ], ...]``, each ρ in (−1, 1)."""
+    if not isinstance(given, list):
+        raise UncertaintySpecError(f"{what}: correlations: a list of [input, input, rho]")
+    out = []
+    for k, item in enumerate(given):
+        where = f"{what}: correlations[{k}]"
+        if not (
+            isinstance(item, list) and len(item) == 3 and all(isinstance(n, str) for n in item[:2])
+        ):
+            raise UncertaintySpecError(f"{where}: [input, input, rho] is needed")
+        rho = _number(item[2], where, UncertaintySpecError)
+        if not -1.0 < rho < 1.0 or item[0] == item[1]:
+            raise UncertaintySpecError(f"{where}: rho in (-1, 1) between two inputs")
+        out.append((item[0], item[1], rho))
+    return out
+
+
+def check_correlations(
+    correlations: list[tuple[str, str, float]], names: list[str], what: str
+) -> None:
+    """Each pair once, and a positive definite matrix (a joint distribution exists)."""
+    pairs = [frozenset(c[:2]) for c in correlations]
+    if len(set(pairs)) != len(pairs):
+        raise UncertaintySpecError(f"{what}: correlations: a pair of inputs appears twice")
+    if correlations and min(np.linalg.eigvalsh(correlation_matrix(correlations, names))) <= 0:
+        raise UncertaintySpecError(
+            f"{what}: correlations: no joint distribution has them (the matrix is not positive "
+            "definite)"
+        )
+
+
+def correlation_matrix(correlations: Any, names: list[str]) -> np.ndarray:
+    """The inputs' correlation matrix, in the order of ``names`` (1 on the diagonal)."""
+    matrix = np.eye(len(names))
+    for first, second, rho in correlations:
+        i, j = names.index(first), names.index(second)
+        matrix[i, j] = matrix[j, i] = rho
+    return matrix
+
+
+def _calibrated_ab(given: Any, base: Path, what: str) -> tuple[dict[str, Distribution], float]:
+    """a and b normal with a calibration's values, standard errors and correlation, from
+    the plate file ``calibrate --out`` wrote."""
+    if not isinstance(given, str):
+        raise UncertaintySpecError(f"{what}: calibration_file: a path is needed")
+    data = load_json_file(base / given, UncertaintySpecError)
+    where = f"{what}: calibration_file {printable(given, 80)}"
+    block = data.get("calibration") if isinstance(data, dict) else None
+    if not isinstance(block, dict):
+        raise UncertaintySpecError(f"{where}: no calibration block (write it with calibrate --out)")
+    keys = ("a_N_m2", "b_kg_m3", "a_stderr_N_m2", "b_stderr_kg_m3", "ab_correlation")
+    values = {}
+    for key in keys:
+        holder = data if key in ("a_N_m2", "b_kg_m3") else block
+        if key not in holder:
+            raise UncertaintySpecError(f"{where}: {key} is missing")
+        values[key] = _number(holder[key], f"{where}: {key}", UncertaintySpecError)
+    rho = values["ab_correlation"]
+    if not -1.0 < rho < 1.0:
+        raise UncertaintySpecError(f"{where}: ab_correlation must lie in (-1, 1)")
+    try:
+        a = Normal(values["a_N_m2"], values["a_stderr_N_m2"])
+        b = Normal(values["b_kg_m3"], values["b_stderr_kg_m3"])
+    except ValueError as exc:
+        raise UncertaintySpecError(f"{where}: {exc}") from None
+    return {"a_N_m2": a, "b_kg_m3": b}, rho

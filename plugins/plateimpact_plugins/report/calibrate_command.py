@@ -159,6 +159,9 @@ def _summary(
         "a_stderr_N_m2": _finite(chosen.a_stderr),
         "b_kg_m3": chosen.b,
         "b_stderr_kg_m3": _finite(chosen.b_stderr),
+        # of the errors of a and b: with the standard errors, their covariance (what
+        # plateimpact uncertainty reads from this file, "calibration_file")
+        "ab_correlation": _finite(chosen.correlation),
         "R": report.dri.R,
         "R_stderr": report.dri.R_stderr,
         "V0_m_s": report.dri.V0,
@@ -178,6 +181,9 @@ def _provenance(
         "shots_file": os.path.basename(args.shots),
         "a_stderr_N_m2": _finite(chosen.a_stderr),
         "b_stderr_kg_m3": _finite(chosen.b_stderr),
+        # of the errors of a and b: with the standard errors, their covariance (what
+        # plateimpact uncertainty reads from this file, "calibration_file")
+        "ab_correlation": _finite(chosen.correlation),
         "R": report.dri.R,
         "V0_m_s": report.dri.V0,
         "sphere": {"radius_mm": sphere.radius / mm, "mass_g": sphere.mass / g},
