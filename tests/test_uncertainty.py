@@ -412,3 +412,17 @@ def test_sobol_indices_refuse_correlated_inputs(registry):
     given["correlations"] = [["speed_m_s", "pstar_mm", 0.3]]
     with pytest.raises(UncertaintySpecError, match="need independent inputs"):
         perforation_indices(read_spec(given, registry), registry, 16)
+
+
+def test_a_seeded_study_on_a_two_process_pool_is_the_same_bits(registry):
+    from concurrent.futures import ProcessPoolExecutor
+
+    given = speed_only(600.0, 30.0, "sobol", 600, seed=5)
+    given["inputs"]["pstar_mm"] = {"uniform": {"low": 2.0, "high": 4.0}}
+    spec = read_spec(given, registry)
+    alone = propagate(spec, registry)
+    with ProcessPoolExecutor(2) as pool:
+        pooled = propagate(spec, registry, executor=pool)
+    assert np.array_equal(alone.result.outcome, pooled.result.outcome)
+    assert np.array_equal(alone.result.exit_speed, pooled.result.exit_speed)
+    assert np.array_equal(alone.result.exit_obliquity, pooled.result.exit_obliquity)

@@ -7,6 +7,7 @@ binomial interval."""
 from __future__ import annotations
 
 import warnings
+from concurrent.futures import Executor
 from typing import Any
 
 import attrs
@@ -157,9 +158,12 @@ def propagate(
     *,
     simulation: Simulation | None = None,
     confidence: float = 0.95,
+    executor: Executor | None = None,
 ) -> Propagation:
     """Sample ``spec``'s inputs and run one scene per sample (``simulation``: the spec's
-    failure model with the registry's defaults otherwise)."""
+    failure model with the registry's defaults otherwise; ``executor``: a process pool or
+    a Dask client's executor, which the batch goes out to in chunks, with the same
+    results bit for bit)."""
     if "speed_m_s" not in spec.at and "speed_m_s" not in spec.inputs:
         raise UncertaintySpecError(
             f"{spec.source}: speed_m_s: give it in at or in inputs (or ask for the limits)"
@@ -167,5 +171,5 @@ def propagate(
     if simulation is None:
         simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     inputs = sample_inputs(spec)
-    result = simulation.run_batch(scenes(spec, inputs, registry))
+    result = simulation.run_batch(scenes(spec, inputs, registry), executor=executor)
     return Propagation(spec, inputs, result, confidence)

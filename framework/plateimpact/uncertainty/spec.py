@@ -8,10 +8,13 @@ line naming the key for anything wrong)::
                 "pstar_mm": {"uniform": {"low": 2.5, "high": 3.5}}},
      "samples": 20000, "method": "mc", "seed": 7}
 
-Values are in each input's user unit. An input with a distribution takes its values from
-it; the others keep the preset's (or ``at``'s) value. A distribution with more than
-:data:`MAX_OUTSIDE` of its probability outside the input's declared range is refused:
-cut it explicitly (``truncnormal``), never clamped.
+``"correlations": [[input, input, rho], ...]`` correlates inputs (a Gaussian copula), and
+``"calibration_file": PATH`` adds the inputs and correlations a calibration recorded in the
+plate file it wrote (``calibration.uncertainty``). Values are in each input's user unit.
+An input with a distribution takes its values from it; the others keep the preset's (or
+``at``'s) value. A distribution with more than :data:`MAX_OUTSIDE` of its probability
+outside the input's declared range is refused: cut it explicitly (``truncnormal``), never
+clamped.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from ..base.errors import PlateImpactError
 from ..base.untrusted import load_json_file, printable
 from ..model.bodies import Plate
 from ..registry.plugin_registry import PluginRegistry
-from .distributions import KINDS, Distribution, Normal
+from .distributions import KINDS, Distribution
 from .inputs import UncertainInput, input_table
 
 #: The methods of sampling: independent draws, scrambled Sobol' points, Latin hypercube.
@@ -188,14 +191,14 @@ def read_spec(
     correlations = list(_correlation_list(data.get("correlations", []), what))
     if "calibration_file" in data:
         base = Path(os.fspath(source)).parent if not isinstance(source, dict) else Path()
-        a_b, correlation = _calibrated_ab(data["calibration_file"], base, what)
-        clash = sorted(set(a_b) & set(inputs))
+        fitted, fitted_correlations = _calibrated(data["calibration_file"], base, what, table)
+        clash = sorted(set(fitted) & set(inputs))
         if clash:
             raise UncertaintySpecError(
                 f"{what}: inputs.{clash[0]}: the calibration_file gives it already"
             )
-        inputs.update(a_b)
-        correlations.append(("a_N_m2", "b_kg_m3", correlation))
+        inputs.update(fitted)
+        correlations += fitted_correlations
     for first, second, _ in correlations:
         for name in (first, second):
             if name not in inputs:
@@ -273,29 +276,25 @@ def correlation_matrix(correlations: Any, names: list[str]) -> np.ndarray:
     return matrix
 
 
-def _calibrated_ab(given: Any, base: Path, what: str) -> tuple[dict[str, Distribution], float]:
-    """a and b normal with a calibration's values, standard errors and correlation, from
-    the plate file ``calibrate --out`` wrote."""
+def _calibrated(
+    given: Any, base: Path, what: str, table: dict[str, UncertainInput]
+) -> tuple[dict[str, Distribution], list[tuple[str, str, float]]]:
+    """The inputs and correlations a calibration recorded in the plate file it wrote
+    (its ``calibration.uncertainty`` block, in a spec's own form: the built-in
+    calibration's a and b, normal with their standard errors and correlation)."""
     if not isinstance(given, str):
         raise UncertaintySpecError(f"{what}: calibration_file: a path is needed")
     data = load_json_file(base / given, UncertaintySpecError)
     where = f"{what}: calibration_file {printable(given, 80)}"
     block = data.get("calibration") if isinstance(data, dict) else None
-    if not isinstance(block, dict):
-        raise UncertaintySpecError(f"{where}: no calibration block (write it with calibrate --out)")
-    keys = ("a_N_m2", "b_kg_m3", "a_stderr_N_m2", "b_stderr_kg_m3", "ab_correlation")
-    values = {}
-    for key in keys:
-        holder = data if key in ("a_N_m2", "b_kg_m3") else block
-        if key not in holder:
-            raise UncertaintySpecError(f"{where}: {key} is missing")
-        values[key] = _number(holder[key], f"{where}: {key}", UncertaintySpecError)
-    rho = values["ab_correlation"]
-    if not -1.0 < rho < 1.0:
-        raise UncertaintySpecError(f"{where}: ab_correlation must lie in (-1, 1)")
-    try:
-        a = Normal(values["a_N_m2"], values["a_stderr_N_m2"])
-        b = Normal(values["b_kg_m3"], values["b_stderr_kg_m3"])
-    except ValueError as exc:
-        raise UncertaintySpecError(f"{where}: {exc}") from None
-    return {"a_N_m2": a, "b_kg_m3": b}, rho
+    found = block.get("uncertainty") if isinstance(block, dict) else None
+    if not isinstance(found, dict) or not isinstance(found.get("inputs"), dict):
+        raise UncertaintySpecError(
+            f"{where}: no calibration.uncertainty block with inputs (write it with calibrate --out)"
+        )
+    inputs = {}
+    for name, distribution in found["inputs"].items():
+        if name not in table:
+            raise UncertaintySpecError(f"{where}: {printable(name, 40)}: unknown input")
+        inputs[name] = _distribution(name, distribution, table[name], where)
+    return inputs, _correlation_list(found.get("correlations", []), where)

@@ -18,6 +18,7 @@ from plateimpact import Plate, PluginRegistry, Shots, Simulation, Sphere, calibr
 from plateimpact import command_line as cli
 
 from .calibrate_pstar_command import add_pstar_options, pstar_command, refuse_pstar_options
+from .constants import DENSITY_B, STRENGTH_A
 
 g, mm = units.g, units.mm
 #: The largest fit run unasked [scenes] (the core's bound; a name here for tests to lower).
@@ -159,9 +160,10 @@ def _summary(
         "a_stderr_N_m2": _finite(chosen.a_stderr),
         "b_kg_m3": chosen.b,
         "b_stderr_kg_m3": _finite(chosen.b_stderr),
-        # of the errors of a and b: with the standard errors, their covariance (what
-        # plateimpact uncertainty reads from this file, "calibration_file")
+        # of the errors of a and b: with the standard errors, their covariance
         "ab_correlation": _finite(chosen.correlation),
+        # the same, as plateimpact uncertainty reads it from this file ("calibration_file")
+        "uncertainty": _uncertainty(chosen),
         "R": report.dri.R,
         "R_stderr": report.dri.R_stderr,
         "V0_m_s": report.dri.V0,
@@ -181,13 +183,30 @@ def _provenance(
         "shots_file": os.path.basename(args.shots),
         "a_stderr_N_m2": _finite(chosen.a_stderr),
         "b_stderr_kg_m3": _finite(chosen.b_stderr),
-        # of the errors of a and b: with the standard errors, their covariance (what
-        # plateimpact uncertainty reads from this file, "calibration_file")
+        # of the errors of a and b: with the standard errors, their covariance
         "ab_correlation": _finite(chosen.correlation),
+        # the same, as plateimpact uncertainty reads it from this file ("calibration_file")
+        "uncertainty": _uncertainty(chosen),
         "R": report.dri.R,
         "V0_m_s": report.dri.V0,
         "sphere": {"radius_mm": sphere.radius / mm, "mass_g": sphere.mass / g},
         "plateimpact_version": cli.versions()["plateimpact"],
+    }
+
+
+def _uncertainty(chosen: Calibration) -> dict[str, Any] | None:
+    """The fit's a and b as an uncertainty spec's inputs and correlation: normal, with
+    their standard errors and the correlation of their errors (None without them)."""
+    numbers = (chosen.a_stderr, chosen.b_stderr, chosen.correlation)
+    if not all(math.isfinite(x) for x in numbers) or min(numbers[:2]) <= 0:
+        return None
+    a_key, b_key = STRENGTH_A.key, DENSITY_B.key
+    return {
+        "inputs": {
+            a_key: {"normal": {"mean": chosen.a, "sd": chosen.a_stderr}},
+            b_key: {"normal": {"mean": chosen.b, "sd": chosen.b_stderr}},
+        },
+        "correlations": [[a_key, b_key, chosen.correlation]],
     }
 
 
