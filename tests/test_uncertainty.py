@@ -26,6 +26,7 @@ from plateimpact.uncertainty import (
     propagate,
     read_spec,
 )
+from plateimpact.uncertainty.curves import outcome_grid
 from plateimpact.uncertainty.limits import sampled_limits
 from plateimpact.uncertainty.propagation import sample_inputs, scenes, unit_samples
 from plateimpact.uncertainty.sensitivity import perforation_indices, sobol_indices
@@ -426,3 +427,45 @@ def test_a_seeded_study_on_a_two_process_pool_is_the_same_bits(registry):
     assert np.array_equal(alone.result.outcome, pooled.result.outcome)
     assert np.array_equal(alone.result.exit_speed, pooled.result.exit_speed)
     assert np.array_equal(alone.result.exit_obliquity, pooled.result.exit_obliquity)
+
+
+def test_the_probability_curve_along_speed_is_the_sampled_limits_curve(registry, sampled):
+    """The same seed draws the same P* samples for the curve and for the sampled limits:
+    at every speed the curve's perforations are the samples whose limit lies below it,
+    apart from a sample whose limit is within the finder's tolerance of the speed."""
+    speeds = np.array([360.0, 380.0, 395.0, 410.0, 430.0])
+    grid = outcome_grid(read_spec(pstar_only(120), registry), registry, speeds)
+    assert grid.counts["perforation"].shape == (speeds.size, 1)
+    for i, speed in enumerate(speeds):
+        below = sampled.ballistic < speed
+        close = int(np.sum(np.abs(sampled.ballistic - speed) <= sampled.tolerance))
+        assert abs(int(grid.counts["perforation"][i, 0]) - int(below.sum())) <= close
+    perforation = grid.probabilities()["perforation"][:, 0]
+    assert np.all(np.diff(perforation) >= 0)  # common samples: monotone in speed here
+
+
+def test_a_grid_over_the_plane_counts_every_sample_once_per_point(registry):
+    grid = outcome_grid(
+        read_spec(pstar_only(50), registry), registry, np.array([300.0, 600.0]),
+        np.array([0.0, 45.0, 75.0]),
+    )  # fmt: skip
+    total = sum(grid.counts.values())
+    assert total.shape == (2, 3) and np.all(total == 50)
+    low, high = grid.intervals()["ricochet"]
+    assert np.all(low <= grid.probabilities()["ricochet"])
+    assert np.all(grid.probabilities()["ricochet"] <= high)
+
+
+def test_a_grid_input_takes_no_distribution(registry):
+    spec = read_spec(speed_only(400.0, 15.0, "mc", 10), registry)
+    with pytest.raises(UncertaintySpecError, match="a grid of it takes no distribution"):
+        outcome_grid(spec, registry, np.array([300.0, 400.0]))
+
+
+def test_the_command_prints_a_probability_curve(tmp_path, capsys):
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(pstar_only(30)))
+    assert main(["uncertainty", str(path), "--speeds", "300:500:3", "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["speeds_m_s"] == [300.0, 400.0, 500.0] and said["obliquities_deg"] == [0.0]
+    assert np.shape(said["probabilities"]["perforation"]) == (3, 1)

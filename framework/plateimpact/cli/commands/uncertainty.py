@@ -11,6 +11,7 @@ from ...model.bodies import THICKNESS
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
 from ...uncertainty import propagate, read_spec
+from ...uncertainty.curves import outcome_grid
 from ...uncertainty.limits import sampled_limits
 from ...uncertainty.sensitivity import perforation_indices
 from ...uncertainty.spec import (
@@ -22,6 +23,7 @@ from ...uncertainty.spec import (
 )
 from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
 from ..formatting import quantity
+from ..limit_options import values
 from ..writer import Writer
 
 
@@ -54,6 +56,17 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
         "in [16, 1,048,576])",
     )
     p.add_argument("--png", metavar="FILE", help="with --sobol: draw the indices as bars")
+    p.add_argument(
+        "--speeds",
+        metavar="SPEEDS",
+        help="instead: outcome probabilities along impact speed [m/s], START:STOP:N or a "
+        "list, the same samples of the other inputs at every speed",
+    )
+    p.add_argument(
+        "--obliquities",
+        metavar="ANGLES",
+        help="the same along obliquity [deg] (with --speeds: over the plane)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_dpi_option(p)
 
@@ -73,6 +86,8 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     check_directory(args.png, "--png", "figure")
     if args.sobol is not None:
         return _sobol(spec, registry, args, out)
+    if args.speeds is not None or args.obliquities is not None:
+        return _grid(spec, registry, args, out)
     if args.limits:
         return _limits(spec, registry, args.json, out)
     with reporting_scenes("uncertainty", spec.samples):
@@ -156,4 +171,28 @@ def _sobol(
     out.say(f"  dominant: {found.dominant()}")
     if args.png is not None:
         out.say(f"figure: {args.png}")
+    return 0
+
+
+def _grid(
+    spec: UncertaintySpec, registry: PluginRegistry, args: argparse.Namespace, out: Writer
+) -> int:
+    speeds = None if args.speeds is None else values(args.speeds, "--speeds", "m/s")
+    angles = None if args.obliquities is None else values(args.obliquities, "--obliquities", "deg")
+    with reporting_scenes("uncertainty"):
+        found = outcome_grid(spec, registry, speeds, angles)
+    summary = found.to_json()
+    if args.json:
+        out.say(json.dumps(summary, indent=2))
+        return 0
+    probability, (low, high) = found.probabilities(), found.intervals()["perforation"]
+    out.say(f"{spec.source}: {spec.samples:,} samples at each point; P(perforation), 95%")
+    out.say("speed_m_s  obliquity_deg  P(ricochet)  P(embedment)  P(perforation)  [low, high]")
+    for i, v in enumerate(found.speeds_m_s):
+        for j, o in enumerate(found.obliquities_deg):
+            out.say(
+                f"{v:9.4g}  {o:13.4g}  {probability['ricochet'][i, j]:11.4f}  "
+                f"{probability['embedment'][i, j]:12.4f}  "
+                f"{probability['perforation'][i, j]:14.4f}  [{low[i, j]:.4f}, {high[i, j]:.4f}]"
+            )
     return 0
