@@ -192,6 +192,7 @@ def test_the_command_prints_probabilities_and_intervals(tmp_path, capsys):
         }
     )
     assert sum(said["probabilities"].values()) == pytest.approx(1.0)
+    assert said["model"]["failure"] == "plugging" and "plateimpact" in said["versions"]
     for name, (low, high) in said["intervals"].items():
         assert low <= said["probabilities"][name] <= high
 

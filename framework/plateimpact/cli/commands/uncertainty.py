@@ -8,8 +8,10 @@ import argparse
 import json
 
 from ...model.bodies import THICKNESS
+from ...provenance.metadata import versions
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
+from ...run.simulation import Simulation
 from ...uncertainty import propagate, read_spec
 from ...uncertainty.curves import outcome_grid
 from ...uncertainty.limits import sampled_limits
@@ -81,18 +83,19 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         method=spec.method if args.method is None else args.method,
         seed=spec.seed if args.seed is None else args.seed,
     )
+    simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     if args.png is not None and args.sobol is None:
         raise UsageError("--png draws the Sobol' indices: give --sobol N too")
     check_directory(args.png, "--png", "figure")
     if args.sobol is not None:
-        return _sobol(spec, registry, args, out)
+        return _sobol(spec, simulation, args, out)
     if args.speeds is not None or args.obliquities is not None:
-        return _grid(spec, registry, args, out)
+        return _grid(spec, simulation, args, out)
     if args.limits:
-        return _limits(spec, registry, args.json, out)
+        return _limits(spec, simulation, args, out)
     with reporting_scenes("uncertainty", spec.samples):
-        found = propagate(spec, registry)
-    summary = found.to_json()
+        found = propagate(spec, registry, simulation=simulation)
+    summary = {**found.to_json(), **_provenance(simulation)}
     if args.json:
         out.say(json.dumps(summary, indent=2))
         return 0
@@ -115,14 +118,23 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     return 0
 
 
-def _limits(spec: UncertaintySpec, registry: PluginRegistry, as_json: bool, out: Writer) -> int:
+def _provenance(simulation: Simulation) -> dict[str, object]:
+    """What produced the numbers: the model's plug-ins with their settings, and versions."""
+    return {"model": simulation.describe(), "versions": versions()}
+
+
+def _limits(
+    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
+) -> int:
+    registry = simulation.registry
+    as_json = args.json
     if "obliquity_deg" in spec.inputs:
         raise UncertaintySpecError(
             f"{spec.source}: obliquity_deg: --limits finds limits at one obliquity: give it in at"
         )
     with reporting_scenes("uncertainty --limits"):
-        found = sampled_limits(spec, registry, spec.at["obliquity_deg"])
-    summary = {**found.to_json(), "spec": spec.describe()}
+        found = sampled_limits(spec, registry, spec.at["obliquity_deg"], simulation=simulation)
+    summary = {**found.to_json(), "spec": spec.describe(), **_provenance(simulation)}
     if as_json:
         out.say(json.dumps(summary, indent=2))
         return 0
@@ -142,22 +154,23 @@ def _limits(spec: UncertaintySpec, registry: PluginRegistry, as_json: bool, out:
 
 
 def _sobol(
-    spec: UncertaintySpec, registry: PluginRegistry, args: argparse.Namespace, out: Writer
+    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
 ) -> int:
+    registry = simulation.registry
     base = args.sobol
     if not (16 <= base <= 2**20 and base & (base - 1) == 0):
         raise UsageError(f"--sobol: a power of 2 in [16, {2**20:,}], got {base}")
     if len(spec.inputs) < 2:
         raise UncertaintySpecError(f"{spec.source}: inputs: --sobol needs two or more")
     with reporting_scenes("uncertainty --sobol", base * (len(spec.inputs) + 2)):
-        found = perforation_indices(spec, registry, base)
+        found = perforation_indices(spec, registry, base, simulation=simulation)
     if args.png is not None:
         from ...figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
 
         thickness = quantity(THICKNESS, spec.plate.thickness, 3)
         title = f"{spec.plate.material}, {thickness}: perforation"
         save_figure_atomically(plot_sobol_indices(found, title), args.png, dpi=args.dpi)
-    summary = {**found.to_json(), "spec": spec.describe()}
+    summary = {**found.to_json(), "spec": spec.describe(), **_provenance(simulation)}
     if args.json:
         out.say(json.dumps(summary, indent=2))
         return 0
@@ -175,13 +188,14 @@ def _sobol(
 
 
 def _grid(
-    spec: UncertaintySpec, registry: PluginRegistry, args: argparse.Namespace, out: Writer
+    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
 ) -> int:
+    registry = simulation.registry
     speeds = None if args.speeds is None else values(args.speeds, "--speeds", "m/s")
     angles = None if args.obliquities is None else values(args.obliquities, "--obliquities", "deg")
     with reporting_scenes("uncertainty"):
-        found = outcome_grid(spec, registry, speeds, angles)
-    summary = found.to_json()
+        found = outcome_grid(spec, registry, speeds, angles, simulation=simulation)
+    summary = {**found.to_json(), **_provenance(simulation)}
     if args.json:
         out.say(json.dumps(summary, indent=2))
         return 0
