@@ -28,7 +28,12 @@ from plateimpact.uncertainty import (
 )
 from plateimpact.uncertainty.curves import outcome_grid
 from plateimpact.uncertainty.limits import sampled_limits
-from plateimpact.uncertainty.propagation import sample_inputs, scenes, unit_samples
+from plateimpact.uncertainty.propagation import (
+    sample_inputs,
+    scenes,
+    study_name,
+    unit_samples,
+)
 from plateimpact.uncertainty.sensitivity import perforation_indices, sobol_indices
 from plateimpact.uncertainty.spec import UncertaintySpecError
 
@@ -470,3 +475,35 @@ def test_the_command_prints_a_probability_curve(tmp_path, capsys):
     said = json.loads(capsys.readouterr().out)
     assert said["speeds_m_s"] == [300.0, 400.0, 500.0] and said["obliquities_deg"] == [0.0]
     assert np.shape(said["probabilities"]["perforation"]) == (3, 1)
+
+
+def test_an_archived_study_is_read_back_on_resume(registry, tmp_path, monkeypatch):
+    """The samples run as a study of the archive, named by the spec; resuming reads the
+    finished run back (no scene runs again: run_batch made to fail) with the same bits;
+    the study records the spec it sampled."""
+    given = speed_only(400.0, 15.0, "lhs", 300, seed=8)
+    spec = read_spec(given, registry)
+    archive = tmp_path / "u.h5"
+    first = propagate(spec, registry, archive=archive)
+    monkeypatch.setattr(
+        pi.Simulation, "run_batch", lambda *a, **k: pytest.fail("a scene ran again")
+    )
+    again = propagate(spec, registry, archive=archive, resume=True)
+    assert np.array_equal(first.result.outcome, again.result.outcome)
+    assert np.array_equal(first.result.exit_speed, again.result.exit_speed)
+    stored = pi.Study.from_archive(archive, study_name(spec))
+    assert json.loads(stored.description) == json.loads(json.dumps(spec.describe()))
+    assert np.array_equal(stored.scenes.columns["impact_speed"], first.inputs["speed_m_s"])
+
+
+def test_the_command_keeps_an_archived_run_unless_resumed(tmp_path, capsys):
+    path, archive = tmp_path / "spec.json", tmp_path / "u.h5"
+    path.write_text(json.dumps(speed_only(400.0, 15.0, "mc", 200)))
+    assert main(["uncertainty", str(path), "--archive", str(archive), "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert main(["uncertainty", str(path), "--archive", str(archive)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "already has run" in err
+    argv = ["uncertainty", str(path), "--archive", str(archive), "--resume", "--json"]
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["probabilities"] == first["probabilities"]

@@ -6,8 +6,12 @@ binomial interval."""
 
 from __future__ import annotations
 
+import hashlib
+import json
+import os
 import warnings
 from concurrent.futures import Executor
+from pathlib import Path
 from typing import Any
 
 import attrs
@@ -159,11 +163,18 @@ def propagate(
     simulation: Simulation | None = None,
     confidence: float = 0.95,
     executor: Executor | None = None,
+    archive: str | os.PathLike[str] | None = None,
+    resume: bool = False,
 ) -> Propagation:
     """Sample ``spec``'s inputs and run one scene per sample (``simulation``: the spec's
     failure model with the registry's defaults otherwise; ``executor``: a process pool or
     a Dask client's executor, which the batch goes out to in chunks, with the same
-    results bit for bit)."""
+    results bit for bit).
+
+    With ``archive``, the samples run as a study of that archive (docs/archive.md): its
+    scenes are the samples [SI], its one run the spec's model, its description the spec
+    as read (distributions, seed, method); the study's name is a digest of the spec, so
+    ``resume=True`` reads back a finished run of the same spec instead of running it."""
     if "speed_m_s" not in spec.at and "speed_m_s" not in spec.inputs:
         raise UncertaintySpecError(
             f"{spec.source}: speed_m_s: give it in at or in inputs (or ask for the limits)"
@@ -171,5 +182,47 @@ def propagate(
     if simulation is None:
         simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     inputs = sample_inputs(spec)
-    result = simulation.run_batch(scenes(spec, inputs, registry), executor=executor)
+    batch = scenes(spec, inputs, registry)
+    if archive is None:
+        result = simulation.run_batch(batch, executor=executor)
+    else:
+        result = _archived(spec, batch, simulation, registry, archive, resume, executor)
     return Propagation(spec, inputs, result, confidence)
+
+
+def study_name(spec: UncertaintySpec) -> str:
+    """The archive's name for the study of ``spec``: the same spec, the same name."""
+    described = {**spec.describe(), "source": ""}  # where it was read from does not matter
+    digest = hashlib.sha256(json.dumps(described, sort_keys=True).encode()).hexdigest()
+    return f"uncertainty-{digest[:12]}"
+
+
+def _archived(
+    spec: UncertaintySpec,
+    batch: SceneBatch,
+    simulation: Simulation,
+    registry: PluginRegistry,
+    archive: str | os.PathLike[str],
+    resume: bool,
+    executor: Executor | None,
+) -> BatchResult:
+    from ..run.variant import Variant  # noqa: PLC0415
+    from ..study.study import Study  # noqa: PLC0415
+
+    described: dict[str, Any] = simulation.describe()
+    slots = ("resistance", "failure", "integrator")
+    variant = Variant(
+        "model",
+        **{slot: described[slot] for slot in slots},
+        **{f"{slot}_settings": described[f"{slot}_settings"] for slot in slots},
+        rest_speed_fraction=described["rest_speed_fraction"],
+    )
+    label = f"{spec.plate.material}/{spec.plate.thickness * 1e3:g}"
+    study = Study(
+        study_name(spec), batch, [variant], [label] * batch.size,
+        description=json.dumps(spec.describe()),
+    )  # fmt: skip
+    found = study.run(
+        archive=Path(os.fspath(archive)), resume=resume, executor=executor, registry=registry
+    )
+    return found["model"]

@@ -69,6 +69,15 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
         metavar="ANGLES",
         help="the same along obliquity [deg] (with --speeds: over the plane)",
     )
+    p.add_argument(
+        "--archive",
+        metavar="FILE",
+        help="run the samples as a study of this archive (HDF5 index and netCDF runs): the "
+        "samples, the spec and the model recorded; outcome probabilities only",
+    )
+    p.add_argument(
+        "--resume", action="store_true", help="with --archive: read back the same spec's run"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_dpi_option(p)
 
@@ -84,6 +93,14 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         seed=spec.seed if args.seed is None else args.seed,
     )
     simulation = Simulation.from_names(failure=spec.failure, registry=registry)
+    others = args.limits or args.sobol is not None or args.speeds or args.obliquities
+    if args.archive is not None and others:
+        raise UsageError(
+            "--archive: the outcome probabilities only (not --limits, --sobol, --speeds or "
+            "--obliquities)"
+        )
+    if args.resume and args.archive is None:
+        raise UsageError("--resume reads back a run of --archive: give --archive FILE too")
     if args.png is not None and args.sobol is None:
         raise UsageError("--png draws the Sobol' indices: give --sobol N too")
     check_directory(args.png, "--png", "figure")
@@ -94,7 +111,9 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     if args.limits:
         return _limits(spec, simulation, args, out)
     with reporting_scenes("uncertainty", spec.samples):
-        found = propagate(spec, registry, simulation=simulation)
+        found = propagate(
+            spec, registry, simulation=simulation, archive=args.archive, resume=args.resume
+        )
     summary = {**found.to_json(), **_provenance(simulation)}
     if args.json:
         out.say(json.dumps(summary, indent=2))
