@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy import integrate, stats
+from scipy import stats
 
 import plateimpact as pi
 from plateimpact import presets
@@ -33,6 +33,10 @@ from plateimpact.uncertainty import propagate, read_spec
 from plateimpact.uncertainty.limits import sampled_limits
 
 RESULTS = Path(__file__).resolve().parent / "results"
+# the closed form the tests check the model against (tests/closed_forms.py)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from closed_forms import ballistic_limit  # noqa: E402
+
 PRESET = "2024-T3/3.18"
 EXAMPLE = {
     "preset": PRESET,
@@ -44,25 +48,6 @@ EXAMPLE = {
     },
     "seed": 7,
 }
-
-
-def ballistic_limit(plate: pi.Plate, sphere: pi.Sphere) -> float:
-    """The closed form at normal incidence with plugging (tests/test_limits.py)."""
-    rs = sphere.radius
-    h = max(rs * math.cos(plate.failure_angle) + plate.critical_penetration - rs, 0.0)
-
-    def area(p: float) -> float:
-        p = min(max(p, 0.0), rs)
-        return math.pi * (2 * rs * p - p * p)
-
-    def net(p: float) -> float:
-        return area(p) - (area(p - h) if p >= plate.critical_penetration else 0.0)
-
-    points = sorted({plate.critical_penetration, rs, h, h + rs})
-    w = integrate.quad(net, 0.0, h + rs, points=points, epsabs=0, epsrel=1e-12, limit=200)[0]
-    a, b, m, f = plate.a, plate.b, sphere.mass, REST_SPEED_FRACTION.default
-    r2 = math.exp(-2 * b * w / m)
-    return math.sqrt(a * (1 - r2) / (b * (r2 - f * f)))
 
 
 def timings(registry: pi.PluginRegistry) -> None:
@@ -97,7 +82,7 @@ def timings(registry: pi.PluginRegistry) -> None:
 
 def convergence(registry: pi.PluginRegistry) -> None:
     plate, sphere = presets.plate(PRESET), presets.DEFAULT_SPHERE
-    limit, sd = ballistic_limit(plate, sphere), 20.0
+    limit, sd = ballistic_limit(plate, sphere, REST_SPEED_FRACTION.default), 20.0
     mean = limit + 0.3 * sd
     exact = 1.0 - stats.norm.cdf((limit - mean) / sd)
     sizes = 2 ** np.arange(6, 13)

@@ -16,9 +16,9 @@ from typing import final
 import attrs
 import numpy as np
 import pytest
+from closed_forms import ballistic_limit
 from hypothesis import given
 from hypothesis import strategies as st
-from scipy import integrate
 
 import plateimpact as pi
 from plateimpact import limits, presets
@@ -144,35 +144,14 @@ def test_a_half_metre_per_second_band_planted_by_a_plug_in_is_found(band_start, 
 # -- the model's own limits ---------------------------------------------------------------
 
 
-def swept_volume(plate: pi.Plate) -> float:
-    """W = ∫ A_net dP at normal incidence with plugging, by quadrature (docs/calibration.md,
-    section 3): A(P) = π (2 Rs p − p²), p = min(P, Rs); beyond P*, the part deeper than
-    the failure plane h = Rs cos α* + P* − Rs no longer resists; done at P = h + Rs."""
-    rs = SPHERE.radius
-    h = max(rs * math.cos(plate.failure_angle) + plate.critical_penetration - rs, 0.0)
-
-    def area(p: float) -> float:
-        p = min(max(p, 0.0), rs)
-        return math.pi * (2 * rs * p - p * p)
-
-    def net(p: float) -> float:
-        return area(p) - (area(p - h) if p >= plate.critical_penetration else 0.0)
-
-    points = sorted({plate.critical_penetration, rs, h, h + rs})
-    return integrate.quad(net, 0.0, h + rs, points=points, epsabs=0, epsrel=1e-12, limit=200)[0]
-
-
 @pytest.mark.parametrize("rest_speed_fraction", [0.01, 1e-6])
 @pytest.mark.parametrize("name", presets.PLATES)
 def test_the_ballistic_limit_at_normal_incidence_is_the_closed_form(name, rest_speed_fraction):
     """a + b Vr² = (a + b Vs²) R², R² = exp(−2bW/m) (eq 40's form, exact for the model at
-    θ = 0). The model ends an impact at rest once V < f Vs (f: rest_speed_fraction), so
-    perforation needs Vr >= f Vs: Vs² = a (1 − R²) / (b (R² − f²)), which is the issue's
-    V0² = (a/b)(e^{2bW/m} − 1) as f -> 0 (docs/limits.md)."""
+    θ = 0): tests/closed_forms.py."""
     plate = presets.plate(name)
-    b, a, m, f = plate.b, plate.a, SPHERE.mass, rest_speed_fraction
-    r2 = math.exp(-2 * b * swept_volume(plate) / m)
-    closed_form = math.sqrt(a * (1 - r2) / (b * (r2 - f * f)))
+    f = rest_speed_fraction
+    closed_form = ballistic_limit(plate, SPHERE, f)
     simulation = pi.Simulation.from_names(rest_speed_fraction=f)
     found = limits.along_speed(simulation, SPHERE, plate, [0.0], (50.0, 2000.0))
     (line,) = found.lines

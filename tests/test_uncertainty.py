@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 import pytest
+from closed_forms import ballistic_limit
 from scipy import stats
-from test_limits import swept_volume
 
 import plateimpact as pi
 from plateimpact import presets
@@ -47,12 +47,8 @@ def registry():
 
 
 def closed_form_ballistic_limit(plate: pi.Plate) -> float:
-    """V_bl at normal incidence with plugging: a + b Vr² = (a + b Vs²) e^{−2bW/m} with the
-    rest speed f Vs as the least residual speed (tests/test_limits.py)."""
-    a, b, m = plate.a, plate.b, SPHERE.mass
-    f = REST_SPEED_FRACTION.default
-    r2 = math.exp(-2 * b * swept_volume(plate) / m)
-    return math.sqrt(a * (1 - r2) / (b * (r2 - f * f)))
+    """V_bl at normal incidence with plugging (tests/closed_forms.py)."""
+    return ballistic_limit(plate, SPHERE, REST_SPEED_FRACTION.default)
 
 
 def speed_only(mean: float, sd: float, method: str, samples: int, seed: int = 3) -> dict:
@@ -507,3 +503,22 @@ def test_the_command_keeps_an_archived_run_unless_resumed(tmp_path, capsys):
     argv = ["uncertainty", str(path), "--archive", str(archive), "--resume", "--json"]
     assert main(argv) == 0
     assert json.loads(capsys.readouterr().out)["probabilities"] == first["probabilities"]
+
+
+@pytest.mark.parametrize(
+    "extra, said",
+    [
+        (["--samples", "1"], "--samples: an integer in [2, 10,000,000]"),
+        (["--seed", "-1"], "--seed: an integer in [0, 2**63)"),
+        (["--resume"], "--resume reads back a run of --archive"),
+        (["--archive", "u.h5", "--limits"], "--archive: the outcome probabilities only"),
+        (["--speeds", "a:b:c"], "--speeds"),
+    ],
+)
+def test_the_commands_flags_refuse_bad_values_in_one_line(tmp_path, capsys, extra, said):
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(speed_only(392.0, 30.0, "mc", 100)))
+    assert main(["uncertainty", str(path), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and said in err, err
+    assert not (tmp_path / "u.h5").exists()

@@ -27,7 +27,14 @@ from ..provenance.metadata import source_commit, versions
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
-from .bracketing import GROUP_SCENES, RELATIVE_FLOOR, SECTIONS, finest_tolerance, locate
+from .bracketing import (
+    GROUP_SCENES,
+    RELATIVE_FLOOR,
+    SECTIONS,
+    Located,
+    finest_tolerance,
+    locate,
+)
 from .chunked import run_chunked
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
 from .regimes import Regime, regime_codes
@@ -176,6 +183,23 @@ def check_steps(
         )
 
 
+def line_of(
+    found: Located, index: int, axis: str, fixed: float, span: tuple[float, float]
+) -> LimitLine:
+    """Line ``index`` of what :func:`~.bracketing.locate` found, as a :class:`LimitLine`
+    along ``axis`` over ``span`` at the other coordinate ``fixed``."""
+    mine = found.line == index
+    boundaries = tuple(
+        Boundary(float(lo), float(hi), Regime.of_code(b), Regime.of_code(a))
+        for lo, hi, b, a in zip(
+            found.low[mine], found.high[mine], found.below[mine], found.above[mine],
+            strict=True,
+        )
+    )  # fmt: skip
+    first = Regime.of_code(int(found.first[index]))
+    return LimitLine(axis, fixed, span[0], span[1], boundaries, first)
+
+
 def _find(
     simulation: Simulation,
     sphere: Sphere,
@@ -222,18 +246,7 @@ def _find(
     starts, ends = np.full(fixed_of_line.size, span[0]), np.full(fixed_of_line.size, span[1])
     found = locate(evaluate, starts, ends, resolution, tolerance, SECTIONS)
     seconds = time.perf_counter() - began
-    lines = []
-    for i, value in enumerate(fixed_of_line):
-        mine = found.line == i
-        boundaries = tuple(
-            Boundary(float(lo), float(hi), Regime.of_code(b), Regime.of_code(a))
-            for lo, hi, b, a in zip(
-                found.low[mine], found.high[mine], found.below[mine], found.above[mine],
-                strict=True,
-            )
-        )  # fmt: skip
-        first = Regime.of_code(int(found.first[i]))
-        lines.append(LimitLine(axis, float(value), span[0], span[1], boundaries, first))
+    lines = [line_of(found, i, axis, float(value), span) for i, value in enumerate(fixed_of_line)]
     model = simulation.describe()
     plugins = {**plugins_record(simulation), "limits": limits_record()}
     n = fixed.size

@@ -16,8 +16,10 @@ from scipy import stats
 from ..base.errors import ParameterError
 from ..limits.bracketing import locate
 from ..limits.chunked import run_chunked
-from ..limits.lines import SPEED, Boundary, LimitLine
-from ..limits.regimes import Regime, regime_codes
+from ..limits.lines import SPEED
+from ..limits.plate_limits import line_of
+from ..limits.regimes import regime_codes
+from ..model.results import Outcome
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from .propagation import sample_inputs, scenes
@@ -126,18 +128,10 @@ def sampled_limits(
     found = locate(evaluate, np.full(n, speeds[0]), np.full(n, speeds[1]), resolution, tolerance)
     ballistic = np.empty(n)
     for i in range(n):
-        mine = found.line == i
-        boundaries = tuple(
-            Boundary(float(lo), float(hi), Regime.of_code(b), Regime.of_code(a))
-            for lo, hi, b, a in zip(
-                found.low[mine], found.high[mine], found.below[mine], found.above[mine],
-                strict=True,
-            )
-        )  # fmt: skip
-        line = LimitLine(SPEED, obliquity, *speeds, boundaries, Regime.of_code(int(found.first[i])))
+        line = line_of(found, i, SPEED, obliquity, speeds)
         limit = line.ballistic_limit
         if limit is None:
-            perforates = line.bands[-1].regime.outcome.name == "PERFORATION"
+            perforates = line.bands[-1].regime.outcome is Outcome.PERFORATION
             limit = -math.inf if perforates else math.inf
         ballistic[i] = limit
     return SampledLimits(spec, obliquity, inputs, ballistic, speeds, tolerance, resolution)

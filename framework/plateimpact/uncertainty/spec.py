@@ -222,16 +222,22 @@ def read_spec(
 
 
 def with_settings(
-    spec: UncertaintySpec, what: str, *, samples: Any, method: Any, seed: Any
+    spec: UncertaintySpec,
+    what: str,
+    *,
+    samples: Any,
+    method: Any,
+    seed: Any,
+    names: tuple[str, str, str] = ("samples", "method", "seed"),
 ) -> UncertaintySpec:
     """``spec`` with its sampling settings checked (``what``: where they came from: the
-    file, or the command line's flags)."""
+    file, or the command line; ``names``: what that place calls them, keys or flags)."""
     if isinstance(samples, bool) or not isinstance(samples, int) or not 2 <= samples <= MAX_SAMPLES:
-        raise UncertaintySpecError(f"{what}: samples: an integer in [2, {MAX_SAMPLES:,}]")
+        raise UncertaintySpecError(f"{what}: {names[0]}: an integer in [2, {MAX_SAMPLES:,}]")
     if method not in METHODS:
-        raise UncertaintySpecError(f"{what}: method: one of {', '.join(METHODS)}")
+        raise UncertaintySpecError(f"{what}: {names[1]}: one of {', '.join(METHODS)}")
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
-        raise UncertaintySpecError(f"{what}: seed: an integer in [0, 2**63)")
+        raise UncertaintySpecError(f"{what}: {names[2]}: an integer in [0, 2**63)")
     return attrs.evolve(spec, samples=samples, method=method, seed=seed)
 
 

@@ -91,6 +91,7 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         samples=spec.samples if args.samples is None else args.samples,
         method=spec.method if args.method is None else args.method,
         seed=spec.seed if args.seed is None else args.seed,
+        names=("--samples", "--method", "--seed"),
     )
     simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     others = args.limits or args.sobol is not None or args.speeds or args.obliquities
