@@ -29,7 +29,8 @@ ENTRY_POINTS = {
     "run/simulation.py": {"Simulation", "Simulation.from_names"},
     "run/variant.py": {"Variant", "Variant.__attrs_post_init__"},  # default plug-ins
     "storage/plate_file.py": {"load_plate_file", "save_plate_file"},
-    "study/study.py": {"Study.grid", "StudyResults.to_xarray"},  # preset names, sphere
+    # preset names, sphere; the plate constants' units of a study's tables
+    "study/study.py": {"Study.grid", "StudyResults.to_xarray", "StudyResults.to_dataframe"},
 }
 
 

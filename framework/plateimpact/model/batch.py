@@ -8,20 +8,21 @@ from __future__ import annotations
 
 import reprlib
 from collections.abc import Iterable, Iterator, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..base.errors import ParameterError
 from ..base.parameters import Parameter, check_instance
-from .bodies import MASS, RADIUS, THICKNESS, Plate, Sphere, check_density
+from . import views
+from .bodies import Plate, Sphere, check_density
+from .fields import CORE_COLUMNS
 from .scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
+from .tables import SceneInputs, scene_table
 
-#: The columns every batch has, whatever the model: the sphere, the plate's thickness
-#: and the impact. Any other column is a plate constant (``a``, ``critical_penetration``,
-#: ...), whose facts belong to the plug-in that declares it.
-CORE_COLUMNS: dict[str, Parameter] = {
-    p.name: p for p in (RADIUS, MASS, THICKNESS, IMPACT_SPEED, IMPACT_OBLIQUITY)
-}
+if TYPE_CHECKING:
+    import pandas
+    import xarray
 
 
 def _numbers(name: str, values: object, *, flat: bool = True) -> np.ndarray:
@@ -267,3 +268,23 @@ class SceneBatch:
         columns = {k: c[index] for k, c in self._columns.items()}
         size = next(iter(columns.values())).size if columns else 0
         return SceneBatch.of(columns, size)
+
+    def to_xarray(self, constants: Mapping[str, Parameter] | None = None) -> xarray.Dataset:
+        """The scenes as an xarray Dataset of coordinates over ``scene`` [SI, CF
+        ``units``]; ``constants`` declares the plate constants' units
+        (``simulation.model.plate_constants()``, ``registry.plate_constants``): one not
+        declared is a number of unit 1 whose description says so."""
+        return scene_table(SceneInputs(self._columns, constants or {}), self.size).to_xarray()
+
+    def to_dataframe(self, constants: Mapping[str, Parameter] | None = None) -> pandas.DataFrame:
+        """The scenes as a pandas DataFrame, one row per scene, in user units with the unit
+        in each column's name (``impact_speed_m_s``); ``constants`` as for
+        :meth:`to_xarray`. pandas is needed (``pip install 'plateimpact[review]'``)."""
+        inputs = SceneInputs(self._columns, constants or {})
+        return scene_table(inputs, self.size).to_dataframe()
+
+    def __repr__(self) -> str:
+        return views.scenes_repr(self.size, SceneInputs(self._columns))
+
+    def _repr_html_(self) -> str:
+        return views.scenes_html(self.size, SceneInputs(self._columns))

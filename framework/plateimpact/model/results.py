@@ -1,128 +1,41 @@
-"""What an impact ends in: outcome, exit state, failure, and optionally the trajectory."""
+"""What an impact ends in: outcome, exit state, failure, and optionally the trajectory.
+
+Each object shows in a notebook as a short text and a small table in user units
+(:mod:`.views`); a batch's results, with the scenes they are of, as an xarray Dataset or
+a pandas DataFrame (:mod:`.tables`).
+"""
 
 from __future__ import annotations
 
-import enum
 import math
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
 
-from ..base.parameters import Parameter
-from ..base.units import deg, mm
+from . import views
+from .batch import SceneBatch
+from .fields import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
 from .ragged import Ragged
+from .tables import LabelledTable, SceneInputs, scene_table
+
+if TYPE_CHECKING:
+    import pandas
+    import xarray
+
+__all__ = [
+    "CRATER_FIELDS",
+    "RESULT_FIELDS",
+    "TRAJECTORY_FIELDS",
+    "BatchResult",
+    "CraterSection",
+    "Outcome",
+    "Result",
+    "Trajectory",
+]
 
 
-class Outcome(enum.IntEnum):
-    """How an impact ends (0 is reserved for "not finished" inside integrators)."""
-
-    RICOCHET = 1
-    EMBEDMENT = 2
-    PERFORATION = 3
-
-    @property
-    def label(self) -> str:
-        """Lower-case name, as the CLI and archives write it."""
-        return self.name.lower()
-
-
-#: Per-scene result columns, with their units: the one source of what archives, CSV
-#: headers and JSON keys call them.
-RESULT_FIELDS: dict[str, Parameter] = {
-    p.name: p
-    for p in (
-        Parameter("outcome", "1 ricochet, 2 embedment, 3 perforation", kind=int),
-        Parameter("exit_speed", "speed when contact ends (0 for embedment)", "m/s"),
-        Parameter(
-            "exit_obliquity",
-            "direction from the plate normal when contact ends, or at rest",
-            "rad",
-            display_unit="deg",
-            scale=deg,
-        ),
-        Parameter("contact_time", "time from first contact to the outcome", "s"),
-        Parameter(
-            "max_penetration", "largest penetration P reached", "m", display_unit="mm", scale=mm
-        ),
-        Parameter(
-            "plate_failed", "whether the plate failed (P reached the onset penetration)", kind=bool
-        ),
-        Parameter("failure_time", "time of plate failure (NaN: none)", "s"),
-        Parameter(
-            "failure_penetration",
-            "penetration at plate failure (NaN: none)",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-        Parameter(
-            "failure_lateral",
-            "lateral displacement at plate failure (NaN: none)",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-    )
-}
-#: Columns of a recorded trajectory (then ``failure_<state>`` for the failure state).
-TRAJECTORY_FIELDS: dict[str, Parameter] = {
-    p.name: p
-    for p in (
-        Parameter("time", "time since first contact", "s"),
-        Parameter(
-            "penetration",
-            "depth P of the sphere's deepest point below the front surface",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-        Parameter(
-            "lateral",
-            "lateral displacement Y of the sphere's centre",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-        Parameter(
-            "obliquity",
-            "direction theta of the velocity from the plate normal",
-            "rad",
-            display_unit="deg",
-            scale=deg,
-        ),
-        Parameter("speed", "speed V", "m/s"),
-    )
-}
-#: Columns of crater sections (eqs 31-39): per point, then per scene.
-CRATER_FIELDS: dict[str, Parameter] = {
-    p.name: p
-    for p in (
-        Parameter(
-            "lateral",
-            "distance along the plate from the crater's entry point",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-        Parameter(
-            "depth",
-            "depth of the crater floor below the front surface",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-        Parameter(
-            "impact_point",
-            "lateral position of first contact in the section's coordinates",
-            "m",
-            display_unit="mm",
-            scale=mm,
-        ),
-    )
-}
-
-
-@attrs.frozen(eq=False)
+@attrs.frozen(eq=False, repr=False)
 class CraterSection:
     """The crater floor in the plane of motion, from entry to exit.
 
@@ -150,14 +63,18 @@ class CraterSection:
         """Deepest point of the floor [m]."""
         return float(self.depth.max())
 
+    def __repr__(self) -> str:
+        return views.crater_repr(np.asarray(self.lateral), np.asarray(self.depth))
 
-@attrs.frozen(eq=False)
+
+@attrs.frozen(eq=False, repr=False)
 class Trajectory:
     """The sampled path of the sphere's centre, one entry per integrator step.
 
     Attributes: time [s]; penetration P [m] (depth of the sphere's deepest point);
     lateral Y [m]; obliquity θ [rad]; speed V [m/s]; failure_state, the failure model's
-    state variables by name (e.g. ``finger_angle`` [rad]), meaningful from failure on.
+    state variables by name (e.g. ``finger_angle`` [rad]), meaningful from failure on;
+    outcome, how the path ended (None where not given).
     """
 
     time: np.ndarray
@@ -166,9 +83,20 @@ class Trajectory:
     obliquity: np.ndarray
     speed: np.ndarray
     failure_state: dict[str, np.ndarray] = attrs.field(factory=dict)
+    outcome: Outcome | None = attrs.field(default=None, kw_only=True)
+
+    def _parts(self) -> list[tuple[str, str]]:
+        columns = {name: np.asarray(getattr(self, name)) for name in TRAJECTORY_FIELDS}
+        return views.trajectory_parts(columns, self.outcome, list(self.failure_state))
+
+    def __repr__(self) -> str:
+        return views.trajectory_repr(self._parts())
+
+    def _repr_html_(self) -> str:
+        return views.trajectory_html(self._parts())
 
 
-@attrs.frozen
+@attrs.frozen(repr=False)
 class Result:
     """The outcome of one scene.
 
@@ -208,6 +136,15 @@ class Result:
         """Exit obliquity [deg]."""
         return math.degrees(self.exit_obliquity)
 
+    def _columns(self) -> dict[str, object]:
+        return {name: getattr(self, name) for name in RESULT_FIELDS}
+
+    def __repr__(self) -> str:
+        return views.result_repr(self._columns())
+
+    def _repr_html_(self) -> str:
+        return views.result_html(self._columns())
+
     def as_user_dict(self) -> dict[str, object]:
         """The result in the user's units (mm, m/s, s, degrees), keys with their units
         (``exit_speed_m_s``), as the CLI prints it; failure values None if it did not."""
@@ -232,7 +169,9 @@ class BatchResult:
     :class:`~plateimpact.model.ragged.Ragged` arrays with one row per scene: the trajectory's
     columns are :data:`TRAJECTORY_FIELDS` then ``failure_<state>``; the craters' are
     ``lateral`` and ``depth`` per point and ``impact_point`` per scene
-    (:data:`CRATER_FIELDS`). ``stats`` counts the integrator's work.
+    (:data:`CRATER_FIELDS`). ``stats`` counts the integrator's work. ``inputs``, when
+    attached, are the scenes they are of (with their plate constants' declarations):
+    :meth:`to_xarray` and :meth:`to_dataframe` give them as coordinates.
     """
 
     def __init__(
@@ -241,6 +180,8 @@ class BatchResult:
         trajectory: Ragged | None = None,
         stats: dict[str, int] | None = None,
         craters: Ragged | None = None,
+        *,
+        inputs: SceneInputs | None = None,
     ) -> None:
         missing = set(RESULT_FIELDS) - set(columns)
         if missing:
@@ -249,6 +190,9 @@ class BatchResult:
         self.trajectory = trajectory
         self.stats = stats or {}
         self.craters = craters
+        if inputs is not None and any(np.size(c) != len(self) for c in inputs.columns.values()):
+            raise ValueError(f"the inputs attached are not of {len(self)} scenes")
+        self.inputs = inputs
 
     @classmethod
     def concat(cls, parts: list[BatchResult]) -> BatchResult:
@@ -260,7 +204,9 @@ class BatchResult:
             trajectory = Ragged.concat([p.trajectory for p in parts])  # type: ignore[misc]
         if parts[0].craters is not None:
             craters = Ragged.concat([p.craters for p in parts])  # type: ignore[misc]
-        return cls(columns, trajectory, stats, craters)
+        found = [p.inputs for p in parts if p.inputs is not None]
+        inputs = SceneInputs.concat(found) if len(found) == len(parts) else None
+        return cls(columns, trajectory, stats, craters, inputs=inputs)
 
     def __len__(self) -> int:
         return int(self.columns["outcome"].size)
@@ -273,7 +219,43 @@ class BatchResult:
             None if self.trajectory is None else self.trajectory.take(index),
             dict(self.stats),
             None if self.craters is None else self.craters.take(index),
+            inputs=None if self.inputs is None else self.inputs.take(index),
         )
+
+    @property
+    def scenes(self) -> SceneBatch | None:
+        """The scenes these are the results of [SI], when they are attached
+        (:meth:`~plateimpact.Simulation.run_batch` and a study's runs attach them)."""
+        if self.inputs is None:
+            return None
+        return SceneBatch.of(dict(self.inputs.columns), len(self))
+
+    def to_xarray(self) -> xarray.Dataset:
+        """The results as an xarray Dataset over ``scene`` [SI, CF ``units``], the scenes'
+        inputs as coordinates (as the archive's run file has them): every column of
+        :data:`RESULT_FIELDS`, the outcome and plate failure as CF flags."""
+        return self._table().to_xarray()
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The results as a pandas DataFrame, one row per scene (index ``scene``), the
+        inputs then the results in user units, each column named with its unit
+        (``impact_obliquity_deg``, ``exit_speed_m_s``), the outcome by name; as
+        ``plateimpact export --to FILE.csv`` writes a run. pandas is needed
+        (``pip install 'plateimpact[review]'``)."""
+        return self._table().to_dataframe()
+
+    def _table(self) -> LabelledTable:
+        return scene_table(self.inputs, len(self), [self.columns])
+
+    def _kept(self) -> list[str]:
+        kept = (("trajectories", self.trajectory), ("craters", self.craters))
+        return [what for what, data in kept if data is not None]
+
+    def __repr__(self) -> str:
+        return views.batch_result_repr(len(self), self.columns, self.inputs, self._kept())
+
+    def _repr_html_(self) -> str:
+        return views.batch_result_html(len(self), self.columns, self.inputs, self._kept())
 
     def __getattr__(self, name: str) -> np.ndarray:
         try:
@@ -287,7 +269,10 @@ class BatchResult:
             return None
         row = self.trajectory.row(i)
         state = {k.removeprefix("failure_"): v for k, v in row.items() if k.startswith("failure_")}
-        return Trajectory(**{k: row[k] for k in TRAJECTORY_FIELDS}, failure_state=state)
+        outcome = Outcome(int(self.columns["outcome"][i]))
+        return Trajectory(
+            **{k: row[k] for k in TRAJECTORY_FIELDS}, failure_state=state, outcome=outcome
+        )
 
     def crater_of(self, i: int) -> CraterSection | None:
         """The crater section of scene ``i``, or None when none was computed."""

@@ -16,6 +16,7 @@ from ..model.crater import crater_sections
 from ..model.impact import REST_SPEED_FRACTION, ImpactModel, describe_plugin
 from ..model.results import BatchResult, Result
 from ..model.scene import Scene
+from ..model.tables import SceneInputs
 from ..registry.plugin_registry import PluginRegistry, default_registry
 from ..solve.driver import ENGINES, choose_engine, integrate
 from ..solve.integrator import Integrator
@@ -135,9 +136,13 @@ class Simulation:
         if executor is None:  # one process: one batch, the fastest way through the loop
             chunk_size = max(batch.size, 1)
         bound = self.model.bind(batch)
-        return run_in_chunks(
+        result = run_in_chunks(
             self, bound, chunk_size, executor, record_trajectory, craters, report_scenes
         )
+        # the scenes, with their plate constants' units, for the result's tables and reprs
+        declared = {**self.registry.plate_constants, **self.model.plate_constants()}
+        result.inputs = SceneInputs(batch.columns, declared)
+        return result
 
     def run(self, scene: Scene, *, record_trajectory: bool = False) -> Result:
         """The result of one scene."""

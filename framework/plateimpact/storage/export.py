@@ -1,7 +1,7 @@
 """Runs for review outside plateimpact: a grid study as an xarray cube, a run as a
 netCDF-4 file or a tidy CSV table (docs/archive.md, "Reviewing archives").
 
-xarray is imported only here, when asked for.
+xarray is imported only when a cube is asked for (model.tables).
 """
 
 from __future__ import annotations
@@ -10,19 +10,20 @@ import math
 import os
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
 from ..base.errors import ParameterError
 from ..base.parameters import Parameter
-from ..model.batch import CORE_COLUMNS
+from ..model.fields import CORE_COLUMNS
 from ..model.results import RESULT_FIELDS, BatchResult, Outcome
+from ..model.tables import PLATE, VARIANT, Column, LabelledTable, column_declaration
 from ..registry.plugin_registry import PluginRegistry
 from .append import StudyDefinition
 from .archive import Archive
 from .data_files import encoded
-from .netcdf import FLAGS, long_name, write_run_file
+from .netcdf import write_run_file
 
 if TYPE_CHECKING:
     import xarray
@@ -34,18 +35,7 @@ CUBE_DIMENSIONS = ("variant", "plate", "impact_obliquity", "impact_speed")
 def declared_column(name: str, registry: PluginRegistry) -> Parameter:
     """What a scene column is: a core column, else a plate constant a plug-in of
     ``registry`` declares, else an undeclared number."""
-    found = CORE_COLUMNS.get(name) or registry.plate_constants.get(name)
-    return found or Parameter(name, f"plate constant {name} (no installed plug-in declares it)")
-
-
-def _attributes(declared: Parameter) -> dict[str, Any]:
-    attributes: dict[str, Any] = {"long_name": long_name(declared)}
-    attributes["description"] = declared.description
-    if declared.name in FLAGS:
-        attributes["flag_values"] = np.array(FLAGS[declared.name][0], dtype=np.int8)
-        attributes["flag_meanings"] = FLAGS[declared.name][1]
-    attributes["units"] = declared.unit or "1"
-    return attributes
+    return column_declaration(name, registry.plate_constants)
 
 
 def study_cube(
@@ -54,8 +44,6 @@ def study_cube(
     """A grid study's ``runs`` (by name) as one Dataset over (variant, plate,
     impact_obliquity, impact_speed) [SI, CF attributes]; ParameterError if the scenes
     are not one full grid of plate × obliquity × speed with one sphere."""
-    import xarray as xr  # noqa: PLC0415
-
     scenes = study.scenes
     columns = scenes.columns
     plates = sorted(set(study.plate_labels))
@@ -73,16 +61,14 @@ def study_cube(
             "study",
             f"study {study.name!r} is not a grid of plate x obliquity x speed "
             f"({flat.size} scenes for {' x '.join(map(str, shape))} cells); "
-            "read its runs scene by scene (Archive.data_file, xarray.open_dataset)",
+            "read its runs scene by scene (StudyResults.to_dataframe, Archive.data_file)",
         )
-    coordinates: dict[str, Any] = {
-        "variant": ("variant", list(runs)),
-        "plate": ("plate", plates),
-        "impact_obliquity": (
-            "impact_obliquity", obliquities, _attributes(CORE_COLUMNS["impact_obliquity"])
-        ),
-        "impact_speed": ("impact_speed", speeds, _attributes(CORE_COLUMNS["impact_speed"])),
-    }  # fmt: skip
+    coordinates: dict[str, Column] = {
+        VARIANT.name: ((VARIANT.name,), np.array(list(runs), dtype=object), VARIANT),
+        PLATE.name: ((PLATE.name,), np.array(plates, dtype=object), PLATE),
+        "impact_obliquity": (("impact_obliquity",), obliquities, CORE_COLUMNS["impact_obliquity"]),
+        "impact_speed": (("impact_speed",), speeds, CORE_COLUMNS["impact_speed"]),
+    }
     plate_index = index[0]
     for name, values in columns.items():
         if name in ("impact_speed", "impact_obliquity"):
@@ -93,22 +79,18 @@ def study_cube(
             raise ParameterError(
                 "study", f"study {study.name!r}: {name} varies within a plate; not one cube"
             )
-        coordinates[name] = ("plate", per_plate, _attributes(declared_column(name, registry)))
-    variables: dict[str, Any] = {}
+        coordinates[name] = ((PLATE.name,), per_plate, declared_column(name, registry))
+    variables: dict[str, Column] = {}
     for name, declared in RESULT_FIELDS.items():
         stack = []
         for run in runs.values():
             values = np.asarray(run.columns[name])
-            values = values.astype(np.int8) if values.dtype == bool else values
             cube = np.empty(shape, dtype=values.dtype)
             cube[index] = values
             stack.append(cube)
-        variables[name] = (CUBE_DIMENSIONS, np.stack(stack), _attributes(declared))
-    return xr.Dataset(
-        variables,
-        coordinates,
-        attrs={"Conventions": "CF-1.11", "study": study.name, "description": study.description},
-    )
+        variables[name] = (CUBE_DIMENSIONS, np.stack(stack), declared)
+    attributes = {"study": study.name, "description": study.description}
+    return LabelledTable(CUBE_DIMENSIONS, coordinates, variables, attributes).to_xarray()
 
 
 def write_run_netcdf(

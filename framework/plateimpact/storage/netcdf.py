@@ -25,22 +25,11 @@ from ..base.errors import ArchiveError
 from ..base.parameters import Parameter
 from ..base.untrusted import load_json
 from ..model.ragged import Ragged
-from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult, Outcome
+from ..model.results import CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, BatchResult
+from ..model.tables import CONVENTIONS, FLAGS, PLATE, SCENE, SCENE_INDEX, long_name
 from .hdf5 import digest
 
-SCENE, SAMPLE, POINT = "scene", "trajectory_sample", "crater_point"
-#: The per-scene label of the plate, a string coordinate.
-PLATE = Parameter("plate", "the plate's label (a preset name, or the study's own)", kind=str)
-#: CF flags of the integer-coded results.
-FLAGS: dict[str, tuple[list[int], str]] = {
-    "outcome": ([int(o) for o in Outcome], " ".join(o.label for o in Outcome)),
-    "plate_failed": ([0, 1], "intact failed"),
-}
-CONVENTIONS = "CF-1.11"
-
-
-def long_name(declared: Parameter) -> str:
-    return declared.name.replace("_", " ")
+SAMPLE, POINT = "trajectory_sample", "crater_point"
 
 
 def _chunk(size: int) -> tuple[int]:
@@ -83,8 +72,7 @@ def write_scenes(
     ``coordinates`` attribute."""
     size = len(plate_labels)
     f.dimensions[SCENE] = size
-    index = Parameter(SCENE, "the scene's index in its study, from 0", kind=int)
-    _variable(f, SCENE, (SCENE,), np.arange(size, dtype=np.int64), index)
+    _variable(f, SCENE, (SCENE,), np.arange(size, dtype=np.int64), SCENE_INDEX)
     for name, values in columns.items():
         _variable(f, name, (SCENE,), values, declared[name])
     _variable(f, PLATE.name, (SCENE,), np.array(list(plate_labels), dtype=object), PLATE)

@@ -13,11 +13,14 @@ import attrs
 import numpy as np
 
 from ..base.errors import ArchiveWaitWarning, ParameterError, UnknownNameError
+from ..base.parameters import Parameter
 from ..comparison.ranges import Comparison
+from ..model import views
 from ..model.batch import SceneBatch, check_chunk_size
 from ..model.bodies import Plate, Sphere
 from ..model.results import BatchResult
 from ..model.scene import Scene
+from ..model.tables import SceneInputs, scene_table
 from ..provenance.metadata import RunMetadata
 from ..registry.plugin_registry import PluginRegistry, default_registry
 from ..run.progress import progress_bar
@@ -28,6 +31,7 @@ from ..storage.lock import ArchiveBusyError
 from .reruns import plan_runs
 
 if TYPE_CHECKING:
+    import pandas
     import xarray
 
 
@@ -283,19 +287,42 @@ class Study:
                         )  # fmt: skip
                     except ArchiveBusyError as exc:  # the run was saved aside: say where
                         warnings.warn(str(exc), ArchiveWaitWarning, stacklevel=2)
-        return StudyResults(self, runs)
+        # the plate constants' units for the results' tables: as the archive has them
+        declared = {}
+        for simulation in simulations.values():
+            declared.update(simulation.registry.plate_constants)
+        return StudyResults(self, runs, constants={**declared, **constants})
 
 
 class StudyResults:
-    """The runs of a study, by name: each a :class:`BatchResult` over the study's scenes."""
+    """The runs of a study, by name: each a :class:`BatchResult` over the study's scenes,
+    with them attached as its inputs (each scene's plate label too; ``constants``
+    declares the plate constants' units)."""
 
-    def __init__(self, study: Study, runs: Mapping[str, BatchResult]) -> None:
+    def __init__(
+        self,
+        study: Study,
+        runs: Mapping[str, BatchResult],
+        *,
+        constants: Mapping[str, Parameter] | None = None,
+    ) -> None:
         self.study = study
         self.runs = dict(runs)
+        self.inputs = SceneInputs(study.scenes.columns, dict(constants or {}), study.plate_labels)
+        for run in self.runs.values():
+            if len(run) == study.scenes.size:
+                run.inputs = self.inputs
 
     @classmethod
-    def from_archive(cls, path: str | os.PathLike[str], study: str | None = None) -> StudyResults:
-        """A study (or the archive's only one) and all its runs, by run name."""
+    def from_archive(
+        cls,
+        path: str | os.PathLike[str],
+        study: str | None = None,
+        *,
+        registry: PluginRegistry | None = None,
+    ) -> StudyResults:
+        """A study (or the archive's only one) and all its runs, by run name; the plate
+        constants' units as ``registry`` declares them (None: unknown)."""
         archive = Archive(path)
         definition = Study.from_archive(path, study)
         runs = {
@@ -303,7 +330,8 @@ class StudyResults:
             for r in archive.runs()
             if r.split("/", 1)[0] == definition.name
         }
-        return cls(definition, runs)
+        constants = None if registry is None else registry.plate_constants
+        return cls(definition, runs, constants=constants)
 
     def to_xarray(self, registry: PluginRegistry | None = None) -> xarray.Dataset:
         """A grid study's runs as one xarray Dataset over (variant, plate,
@@ -316,6 +344,32 @@ class StudyResults:
         registry = default_registry() if registry is None else registry
 
         return study_cube(self.study, self.runs, registry=registry)
+
+    def to_dataframe(self, registry: PluginRegistry | None = None) -> pandas.DataFrame:
+        """Every run's scenes as rows of one pandas DataFrame, indexed by (variant,
+        scene): the plate, the inputs and the results in user units, each column named
+        with its unit (``impact_obliquity_deg``, ``exit_speed_m_s``), the outcome by
+        name; any study, grid or not. Plate constants as ``registry`` declares them
+        (an entry point of the API: without one, the installed plug-ins'). pandas is
+        needed (``pip install 'plateimpact[review]'``)."""
+        registry = default_registry() if registry is None else registry
+        study = self.study
+        inputs = SceneInputs(study.scenes.columns, registry.plate_constants, study.plate_labels)
+        columns = [run.columns for run in self.runs.values()]
+        table = scene_table(inputs, study.scenes.size, columns, list(self.runs))
+        return table.to_dataframe()
+
+    def __repr__(self) -> str:
+        runs = {name: run.columns for name, run in self.runs.items()}
+        size = self.study.scenes.size
+        return views.runs_repr("StudyResults", self.study.name, size, self.inputs, runs)
+
+    def _repr_html_(self) -> str:
+        runs = {name: run.columns for name, run in self.runs.items()}
+        study = self.study
+        return views.runs_html(
+            "StudyResults", study.name, study.description, study.scenes.size, self.inputs, runs
+        )
 
     def __getitem__(self, name: str) -> BatchResult:
         try:

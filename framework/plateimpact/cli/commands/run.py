@@ -9,11 +9,12 @@ from typing import Any
 
 from ...model.results import RESULT_FIELDS, TRAJECTORY_FIELDS
 from ...model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED, Scene
+from ...model.views import result_quantities
 from ...registry.plugin_registry import PluginRegistry
 from ...run.simulation import Simulation
 from ...storage.together import write_together
 from ..common import UsageError, check_directory, csv_text
-from ..formatting import DURATION, quantity, shown, user
+from ..formatting import quantity, shown, user
 from ..scenes import add_scene_options, scene_of
 from ..sidecar import csv_and_sidecar, sidecar
 from ..writer import Writer
@@ -107,22 +108,11 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
 
 def _print(out: Writer, scene: Scene, label: str, result: Any) -> None:
     """The result as text, each quantity in the unit its declaration gives."""
-    field = RESULT_FIELDS
     impact = (
         f"{quantity(IMPACT_SPEED, scene.impact_speed)} at "
         f"{quantity(IMPACT_OBLIQUITY, scene.impact_obliquity)}"
     )
     out.say(f"{shown(label, None)}: {impact} -> {result.outcome.label}")
-    out.say(f"  exit speed       {quantity(field['exit_speed'], result.exit_speed)}")
-    out.say(f"  exit obliquity   {quantity(field['exit_obliquity'], result.exit_obliquity)}")
-    out.say(f"  contact time     {quantity(DURATION, result.contact_time)}")
-    out.say(f"  max penetration  {quantity(field['max_penetration'], result.max_penetration)}")
-    if result.plate_failed:
-        out.say(
-            f"  plate failed     at P = "
-            f"{quantity(field['failure_penetration'], result.failure_penetration)}, "
-            f"Y = {quantity(field['failure_lateral'], result.failure_lateral)}, "
-            f"t = {quantity(DURATION, result.failure_time)}"
-        )
-    else:
-        out.say("  plate failed     no")
+    values = {name: getattr(result, name) for name in RESULT_FIELDS}
+    for what, value in result_quantities(values):  # as the Result's repr says them
+        out.say(f"  {what:16} {value}")
