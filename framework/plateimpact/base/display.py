@@ -66,22 +66,29 @@ def heading(label: str, declared: Parameter) -> str:
     return f"{label} [{shown}]" if shown else label
 
 
-def cell(declared: Parameter, value: float | None, digits: int = 6) -> str:
-    """A table cell: ``value`` [SI] in the user's unit, without it (the heading has it);
-    ``-`` for none (None or NaN)."""
+def cell(declared: Parameter, value: float | None, digits: int = 6, style: str = "g") -> str:
+    """A table cell: ``value`` [SI] in the user's unit, without it (the heading has it),
+    to ``digits`` significant digits (``style`` ``g``) or decimals (``f``); ``-`` for
+    none (None or NaN)."""
     if value is None or math.isnan(float(value)):
         return "-"
-    return f"{user(declared, value):.{digits}g}"
+    return f"{user(declared, value):.{digits}{style}}"
 
 
-def spread(declared: Parameter, values: np.ndarray, with_unit: bool = True) -> str:
-    """What a column holds, in the user's unit: its one value, its few values, or its
-    range and how many distinct values (``50 to 1500 m/s (59 values)``; without the
-    unit for a table whose heading has it)."""
+def spread(
+    declared: Parameter,
+    values: np.ndarray,
+    with_unit: bool = True,
+    digits: int = 6,
+    style: str = "g",
+) -> str:
+    """What a column holds, in the user's unit (each value as :func:`cell` writes it):
+    its one value, its few values, or its range and how many distinct values (``50 to
+    1500 m/s (59 values)``; without the unit for a table whose heading has it)."""
     distinct = np.unique(np.asarray(values, dtype=float))
     if distinct.size == 0:
         return "none"
-    shown = [cell(declared, float(x)) for x in distinct]
+    shown = [cell(declared, float(x), digits, style) for x in distinct]
     if len(shown) > LISTED_VALUES:
         text = f"{shown[0]} to {shown[-1]}"
         suffix = f" ({len(shown)} values)"

@@ -9,15 +9,14 @@ prints inert, and a value of the wrong type prints as what it is instead of fail
 
 from __future__ import annotations
 
-import json
 import math
 from typing import Any
 
 import numpy as np
 
-from ..base.parameters import Parameter
 from ..model.batch import CORE_COLUMNS, SceneBatch
 from ..model.results import BatchResult
+from ..registry.described import plugin_line, stored_value
 from ..registry.plugin_registry import KINDS, PluginRegistry
 from ..storage.archive import Archive
 from .formatting import LONGEST_TEXT, shown
@@ -35,40 +34,11 @@ def seconds(value: object) -> str:
     return shown(value)
 
 
-def _value(declared: Parameter | None, value: object) -> str:
-    """A value [SI] in the user's unit, with the unit; a value the declaration cannot
-    describe (an archive's, of another version of the plug-in) as it is stored."""
-    if declared is None:
-        return shown(json.dumps(value) if not isinstance(value, str) else value)
-    unit = "" if declared.user_unit == "1" or value is None else f" {declared.user_unit}"
-    try:
-        return f"{shown(declared.format(value))}{unit}"
-    except Exception:  # a plug-in's own formatting of a stored value: show the value
-        return shown(json.dumps(value, default=str))
-
-
-def _plugin(kind: str, model: dict[str, Any], plugins: PluginRegistry) -> str:
-    """``dopri5 1 (rtol 1e-09, ...)``: name, version and every setting (declared by
-    ``plugins`` where it has the plug-in)."""
-    name = model.get(kind)
-    declarations: dict[str, Parameter] = {}
-    if isinstance(name, str) and name in plugins.names(kind):
-        declarations = plugins.get(kind, name).setting_declarations()
-    # not installed here: the settings as stored [SI]
-    stored = model.get(f"{kind}_settings")
-    settings = ", ".join(
-        f"{shown(setting)} {_value(declarations.get(setting), value)}"
-        for setting, value in (stored.items() if isinstance(stored, dict) else [])
-    )
-    version = shown(model.get(f"{kind}_version", "?"))
-    return f"{shown(name)} {version} ({settings or 'no settings'})"
-
-
 def run_lines(meta: dict[str, Any], registry: PluginRegistry) -> list[str]:
     """The model, commit and versions of an archived run (its metadata)."""
     model = meta.get("model")
     model = model if isinstance(model, dict) else {}
-    lines = [f"  {kind}: {_plugin(kind, model, registry)}" for kind in KINDS]
+    lines = [f"  {kind}: {plugin_line(kind, model, registry)}" for kind in KINDS]
     lines.append(f"  rest_speed_fraction: {shown(model.get('rest_speed_fraction'))}")
     found = meta.get("versions")
     versions = ", ".join(
@@ -85,7 +55,7 @@ def scene_line(scenes: SceneBatch, plate_labels: tuple[str, ...], registry: Plug
     columns = scenes.columns
     parts = [f"plates {', '.join(shown(label) for label in dict.fromkeys(plate_labels))}"]
     for name in sorted(columns, key=lambda n: (n not in CORE_COLUMNS, n)):
-        distinct = [_value(declared.get(name), float(x)) for x in np.unique(columns[name])]
+        distinct = [stored_value(declared.get(name), float(x)) for x in np.unique(columns[name])]
         if len(distinct) > LISTED_VALUES:
             distinct = [f"{distinct[0]} to {distinct[-1]} ({len(distinct)} values)"]
         parts.append(f"{shown(name)} {', '.join(distinct)}")

@@ -21,13 +21,14 @@ from ..base.errors import ArchiveError, ParameterError, PlateImpactError
 from ..base.parameters import Parameter
 from ..base.untrusted import printable
 from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
+from ..model.tables import long_name
 from ..provenance.metadata import git_commit, versions
 from ..registry.plugin_registry import PluginRegistry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import FORMAT as PLATE_FORMAT
 from ..storage.records import Record, RecordColumn
-from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
+from .lines import NAMED_LIMITS, OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
 from .plate_limits import Limits
 from .regimes import REGIMES, Regime
@@ -76,23 +77,13 @@ def _axis_columns(limits: Limits) -> dict[str, RecordColumn]:
             f"each line's regime at its start: {_CODES}",
         ),
     }
-    if axis == SPEED:
-        for key, what in (
-            ("ballistic_limit", "lowest speed above which every scene perforates"),
-            ("lowest_perforation", "lowest perforating speed, if below the ballistic limit"),
-            ("ricochet_limit", "highest speed at which the sphere ricochets"),
-        ):
-            values = [named(getattr(line, key)) for line in lines]
-            columns[f"lines/{key}"] = RecordColumn(
-                np.array(values), unit, key.replace("_", " "), f"the {what} (NaN: none on the line)"
-            )
-    else:
-        values = [named(line.critical_ricochet_obliquity) for line in lines]
-        columns["lines/critical_ricochet_obliquity"] = RecordColumn(
+    for declared in NAMED_LIMITS[axis]:
+        values = [named(getattr(line, declared.name)) for line in lines]
+        columns[f"lines/{declared.name}"] = RecordColumn(
             np.array(values),
-            unit,
-            "critical ricochet obliquity",
-            "the lowest obliquity above which every scene ricochets (NaN: none on the line)",
+            declared.unit,
+            long_name(declared),
+            f"the {declared.description} (NaN: none on the line)",
         )
     found = [(i, b) for i, line in enumerate(lines) for b in line.boundaries]
     at = np.array([b.at for _, b in found], dtype=float)

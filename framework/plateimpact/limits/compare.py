@@ -16,6 +16,7 @@ from typing import Any, TypeVar
 import attrs
 
 from ..base.errors import ParameterError
+from . import views
 from .lines import OBLIQUITY, SPEED, Band, Boundary, LimitLine, unit_suffix
 from .maps import OutcomeMap
 from .plate_limits import Limits
@@ -62,7 +63,7 @@ class LineComparison:
     bands_only_in_b: tuple[Band, ...]
 
 
-@attrs.frozen
+@attrs.frozen(repr=False)
 class LimitsComparison:
     """``lines``: the lines both have; ``lines_only_in_a``, ``lines_only_in_b``: the
     fixed values of the others [rad or m/s]."""
@@ -77,6 +78,12 @@ class LimitsComparison:
     @property
     def fixed_axis(self) -> str:
         return OBLIQUITY if self.axis == SPEED else SPEED
+
+    def __repr__(self) -> str:
+        return views.comparison_repr(self)
+
+    def _repr_html_(self) -> str:
+        return views.comparison_html(self)
 
     def to_json(self) -> dict[str, Any]:
         """In user units, the unit in every key (``shift_m_s`` or ``shift_deg``)."""

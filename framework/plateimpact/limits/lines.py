@@ -11,6 +11,7 @@ from typing import Any
 
 import attrs
 
+from ..base.parameters import Parameter
 from ..model.results import Outcome
 from .regimes import Regime
 
@@ -18,6 +19,26 @@ from .regimes import Regime
 #: a fixed speed.
 SPEED, OBLIQUITY = "impact_speed", "impact_obliquity"
 _DEG = math.pi / 180.0
+#: The named limits of a line along each axis (the properties of :class:`LimitLine`),
+#: declared: what each is and its unit.
+NAMED_LIMITS: dict[str, tuple[Parameter, ...]] = {
+    SPEED: (
+        Parameter("ballistic_limit", "lowest speed above which every scene perforates", "m/s"),
+        Parameter(
+            "lowest_perforation", "lowest perforating speed, if below the ballistic limit", "m/s"
+        ),
+        Parameter("ricochet_limit", "highest speed at which the sphere ricochets", "m/s"),
+    ),
+    OBLIQUITY: (
+        Parameter(
+            "critical_ricochet_obliquity",
+            "lowest obliquity above which every scene ricochets",
+            "rad",
+            display_unit="deg",
+            scale=_DEG,
+        ),
+    ),
+}
 
 
 def _user(axis: str, value: float | None) -> float | None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from concurrent.futures import Executor
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -22,6 +23,7 @@ from ..model.bodies import Plate, Sphere
 from ..model.results import BatchResult
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ..run.simulation import Simulation
+from . import views
 from .bracketing import RELATIVE_FLOOR, finest_tolerance, scan_points
 from .lines import SPEED
 from .plate_limits import (
@@ -35,6 +37,10 @@ from .plate_limits import (
 )
 from .regimes import Regime, regime_codes
 
+if TYPE_CHECKING:
+    import pandas
+    import xarray
+
 #: The default grid: 200 speeds over 50-2000 m/s, 86 obliquities 0-85 deg.
 MAP_SPEED_SAMPLES = 200
 MAP_OBLIQUITIES = np.radians(np.arange(0.0, 86.0))
@@ -42,7 +48,7 @@ MAP_OBLIQUITIES = np.radians(np.arange(0.0, 86.0))
 MAX_MAP_SCENES = 1_000_000
 
 
-@attrs.frozen(eq=False)
+@attrs.frozen(eq=False, repr=False)
 class OutcomeMap:
     """Regimes and exit states on a grid of impact ``speeds`` [m/s] (columns) and
     ``obliquities`` [rad] (rows): ``regime`` (an :class:`~plateimpact.Outcome` per
@@ -61,6 +67,25 @@ class OutcomeMap:
     def shape(self) -> tuple[int, int]:
         """(obliquities, speeds)."""
         return self.regime.shape
+
+    def to_xarray(self) -> xarray.Dataset:
+        """The grid as an xarray Dataset over (``impact_obliquity`` [rad],
+        ``impact_speed`` [m/s]): each cell's ``outcome`` and ``plate_failed`` (CF flags),
+        ``exit_speed`` [m/s] and ``exit_obliquity`` [rad]; what produced it as
+        attributes."""
+        return views.map_table(self).to_xarray()
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The grid, one row per cell (index ``impact_obliquity_deg``,
+        ``impact_speed_m_s``), in user units with the unit in each column's name. pandas
+        is needed (``pip install 'plateimpact[review]'``)."""
+        return views.map_table(self).to_dataframe()
+
+    def __repr__(self) -> str:
+        return views.map_repr(self)
+
+    def _repr_html_(self) -> str:
+        return views.map_html(self)
 
     def boundary_curves(self) -> list[tuple[Regime, Regime, np.ndarray, np.ndarray]]:
         """The boundaries as curves: (below, above, speeds [m/s], obliquities [rad]),

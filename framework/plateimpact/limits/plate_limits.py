@@ -11,7 +11,7 @@ import math
 import time
 from collections.abc import Iterable, Sequence
 from concurrent.futures import Executor
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import attrs
 import numpy as np
@@ -27,6 +27,7 @@ from ..provenance.metadata import source_commit, versions
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
+from . import views
 from .bracketing import (
     GROUP_SCENES,
     RELATIVE_FLOOR,
@@ -39,6 +40,10 @@ from .chunked import run_chunked
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine, unit_suffix
 from .regimes import Regime, regime_codes
 
+if TYPE_CHECKING:
+    import pandas
+    import xarray
+
 _DEG = math.pi / 180.0
 #: Defaults: boundaries to 0.01 m/s or 0.001 deg; no band of 1 m/s or 0.1 deg missed.
 SPEED_TOLERANCE, SPEED_RESOLUTION = 0.01, 1.0  # [m/s]
@@ -50,7 +55,7 @@ OBLIQUITY_RANGE = (0.0, 89.0 * _DEG)  # [rad]
 MAX_SCAN_SCENES = 1_000_000
 
 
-@attrs.frozen(eq=False)
+@attrs.frozen(eq=False, repr=False)
 class Limits:
     """The bands of every line of one request, with what produced them.
 
@@ -87,6 +92,25 @@ class Limits:
             )
         record = plate_to_dict(self.plate, registry=self.registry)
         return {k: v for k, v in record.items() if k != "format"}
+
+    def to_xarray(self) -> xarray.Dataset:
+        """The named limits of every line as an xarray Dataset over the lines' fixed
+        coordinate (``impact_obliquity`` [rad] along speed, ``impact_speed`` [m/s] along
+        obliquity) [SI, CF ``units``; NaN: none on the line], with the plate, sphere,
+        model and tolerance as attributes."""
+        return views.limits_table(self).to_xarray()
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The named limits of every line, one row per line, in user units with the unit
+        in each column's name (``ballistic_limit_m_s``, index ``impact_obliquity_deg``).
+        pandas is needed (``pip install 'plateimpact[review]'``)."""
+        return views.limits_table(self).to_dataframe()
+
+    def __repr__(self) -> str:
+        return views.limits_repr(self)
+
+    def _repr_html_(self) -> str:
+        return views.limits_html(self)
 
     def to_json(self) -> dict[str, Any]:
         """One object in user units (``plateimpact limits --json``)."""

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from collections.abc import Callable
 
 from ... import limits as lim
+from ...limits.views import band_texts, decimals
 from ...model.scene import IMPACT_OBLIQUITY
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
@@ -156,18 +156,13 @@ def _print(found: lim.Limits, label: str, outcomes: list[str] | None, out: Write
     tolerance resolves."""
     axis = AXES[found.axis]
     other = AXES[lim.OBLIQUITY if found.axis == lim.SPEED else lim.SPEED]
-    digits = max(0, -math.floor(math.log10(found.tolerance / axis.scale)))
+    digits = decimals(found.axis, found.tolerance)
 
     def show(x: float | None) -> str:
         return "none in range" if x is None else f"{number(axis, x, digits, 'f')} {unit(axis)}"
 
     for line in found.lines:
-        bands = [
-            f"{b.regime.label} {number(axis, b.start, digits, 'f')}-"
-            f"{number(axis, b.end, digits, 'f')}"
-            for b in line.bands
-            if not outcomes or b.regime.outcome.label in outcomes
-        ]
+        bands = band_texts(found.axis, line, digits, outcomes)
         where = f"{number(other, line.fixed)} {unit(other)}"
         if found.axis == lim.SPEED:
             named = (
