@@ -7,7 +7,18 @@ import math
 import attrs
 import numpy as np
 
-from ..base.errors import CalibrationError
+from ..base.display import (
+    SPEED,
+    cell,
+    heading,
+    html_block,
+    html_fields,
+    html_table,
+    quantity,
+    short_repr,
+)
+from ..base.errors import CalibrationError, ParameterError
+from ..storage.shots import Shots
 
 #: Fewest perforating shots a DRI fit takes: two fix R and V0, a third leaves a residual.
 MIN_PERFORATIONS = 3
@@ -16,7 +27,7 @@ MIN_PERFORATIONS = 3
 SPEED_SPREAD = 1e-6
 
 
-@attrs.frozen(eq=False)
+@attrs.frozen(eq=False, repr=False)
 class DriFit:
     """Least-squares fit of Vr = R (Vs² − V0²)^½ (eq 40) to perforating shots.
 
@@ -49,19 +60,52 @@ class DriFit:
         """Root mean square of :attr:`residuals` [m/s]."""
         return float(np.sqrt(np.mean(self.residuals**2)))
 
+    def __repr__(self) -> str:
+        parts = [
+            f"R {self.R:.5g} +/- {self.R_stderr:.2g}",
+            f"V0 {cell(SPEED, self.V0, 5)} +/- {quantity(SPEED, self.V0_stderr, 2)}",
+            f"{self.impact_speed.size:,} perforating shots",
+            f"rms residual {quantity(SPEED, self.rms_residual, 3)}",
+        ]
+        return short_repr("DriFit", parts)
+
+    def _repr_html_(self) -> str:
+        rows = [
+            ["R", f"{self.R:.5g}", f"{self.R_stderr:.2g}"],
+            [heading("V0", SPEED), cell(SPEED, self.V0, 5), cell(SPEED, self.V0_stderr, 2)],
+        ]
+        fields = [
+            ("perforating shots", f"{self.impact_speed.size:,}"),
+            (heading("rms residual", SPEED), cell(SPEED, self.rms_residual, 3)),
+        ]
+        tables = html_table(["", "estimate", "standard error"], rows), html_fields(fields)
+        return html_block("DriFit: Vr = R (Vs^2 - V0^2)^(1/2) (eq 40)", *tables)
+
     def residual_speed(self, impact_speed: np.ndarray | float) -> np.ndarray:
         """The fitted curve, eq 40 [m/s], 0 below the ballistic limit; ``impact_speed`` [m/s]."""
         vs = np.asarray(impact_speed, dtype=float)
         return self.R * np.sqrt(np.clip(vs**2 - self.V0**2, 0.0, None))
 
 
-def fit_dri(impact_speed: np.ndarray, residual_speed: np.ndarray) -> DriFit:
+def fit_dri(impact_speed: np.ndarray | Shots, residual_speed: np.ndarray | None = None) -> DriFit:
     """DRI fit (eqs 40–41) of the perforating shots among ``impact_speed``,
-    ``residual_speed`` [m/s]; shots with residual speed 0 are left out.
+    ``residual_speed`` [m/s]; shots with residual speed 0 are left out. Or
+    ``impact_speed`` is :class:`~plateimpact.Shots` alone, at one obliquity: the residual
+    speeds of those that perforated (a ricochet's exit speed is not one), the same fit.
 
     Raises :class:`CalibrationError` with fewer than three perforating shots or when the
     fit has no ballistic limit (V0² <= 0) or R <= 0.
     """
+    if isinstance(impact_speed, Shots):
+        if residual_speed is not None:
+            raise ParameterError(
+                "residual_speed", "give Shots alone, or impact and residual speeds as arrays"
+            )
+        shots = impact_speed.at_one_obliquity("a DRI fit")
+        impact_speed = shots.impact_speed
+        residual_speed = np.where(shots.perforated, shots.residual_speed, 0.0)
+    elif residual_speed is None:
+        raise ParameterError("residual_speed", "residual_speed is needed with impact speeds")
     vs = np.asarray(impact_speed, dtype=float).reshape(-1)
     vr = np.asarray(residual_speed, dtype=float).reshape(-1)
     used = vr > 0.0

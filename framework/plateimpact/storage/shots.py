@@ -176,6 +176,20 @@ class Shots:
             for k, obliquity in enumerate(obliquities)
         }
 
+    def at_one_obliquity(self, what: str) -> Shots:
+        """These shots, when they are all at one impact obliquity (a V50 or a DRI fit is
+        of one); :class:`ShotDataError` naming the obliquities otherwise. ``what`` names
+        the fit (``"a V50"``)."""
+        found = np.unique(self.impact_obliquity)
+        if found.size > 1:
+            listed = ", ".join(f"{x / IMPACT_OBLIQUITY.scale:g}" for x in found[:6])
+            more = ", ..." if found.size > 6 else ""
+            raise ShotDataError(
+                f"{self.source}: shots at {found.size} obliquities ({listed}{more} deg): "
+                f"{what} is of one obliquity; fit each of shots.groups_by_obliquity()"
+            )
+        return self
+
     def spheres(self, sphere: Sphere) -> tuple[np.ndarray, np.ndarray]:
         """(radius [m], mass [kg]) of each shot: its own where given, else ``sphere``'s;
         :class:`ShotDataError` naming the shot whose sphere is not a solid's density."""

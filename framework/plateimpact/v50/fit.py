@@ -14,8 +14,19 @@ import attrs
 import numpy as np
 
 from ..base.errors import ParameterError
+from ..storage.shots import Shots
+from . import views
 from .bootstrap import bootstrap_intervals
-from .likelihood import PROBIT, check_arrays, check_shots, increasing, link_of, prepared, rounds
+from .likelihood import (
+    PROBIT,
+    SHOTS,
+    check_shots,
+    go_no_go,
+    increasing,
+    link_of,
+    prepared,
+    rounds,
+)
 from .profile import Interval, profile_intervals
 from .solver import maximum
 
@@ -26,7 +37,7 @@ CONFIDENCE_RANGE = (0.5, 0.999)
 DEFAULT_BOOTSTRAP, MAX_BOOTSTRAP = 1000, 100_000
 
 
-@attrs.frozen(eq=False)
+@attrs.frozen(eq=False, repr=False)
 class V50Fit:
     """A probit or logit fit of P(perforation) = F((v − V50)/s) to go/no-go shots.
 
@@ -80,6 +91,12 @@ class V50Fit:
         z = (np.asarray(speed, dtype=float) - self.v50_m_s) / self.scale_m_s
         return np.asarray(np.exp(link_of(self.method).log_cdf(z)))
 
+    def __repr__(self) -> str:
+        return views.fit_repr(self)
+
+    def _repr_html_(self) -> str:
+        return views.fit_html(self)
+
     def to_json(self) -> dict[str, Any]:
         """The fit as JSON values: m/s, intervals as [low, high] lists (null: unbounded)."""
         found = {f.name: getattr(self, f.name) for f in attrs.fields(V50Fit)}
@@ -107,25 +124,28 @@ def _check_options(confidence: float, bootstrap: int) -> None:
 
 
 def fit_v50(
-    speed: np.ndarray,
-    perforated: np.ndarray,
+    speed: np.ndarray | Shots,
+    perforated: np.ndarray | None = None,
     weight: np.ndarray | None = None,
     *,
     method: str = PROBIT,
     confidence: float = 0.95,
     bootstrap: int = DEFAULT_BOOTSTRAP,
     rng: np.random.Generator | int | None = 0,
-    label: str = "shots",
+    label: str = SHOTS,
 ) -> V50Fit:
     """Fit P(perforation) = F((v − V50)/s) to go/no-go shots by maximum likelihood.
 
     ``speed`` [m/s], ``perforated`` (bool) and ``weight`` (frequency weights >= 0,
-    default 1) have one value per shot. ``method`` is ``probit`` (F = Φ) or ``logit``
-    (the logistic CDF). ``confidence`` sets the intervals' level; ``bootstrap``
-    resamples (0: none) are drawn with ``rng`` (a Generator, or a seed: the default 0
-    makes a fit reproducible). ``label`` names the shots in error messages. The shots
-    are taken in one order (by speed, outcome, weight), so the fit and its bootstrap do
-    not depend on the order given.
+    default 1) have one value per shot; or ``speed`` is :class:`~plateimpact.Shots`
+    (what :meth:`~plateimpact.Shots.from_csv` reads), alone: shots at one obliquity,
+    their ``impact_speed``, ``perforated`` and ``weight``, the same fit. ``method`` is
+    ``probit`` (F = Φ) or ``logit`` (the logistic CDF). ``confidence`` sets the
+    intervals' level; ``bootstrap`` resamples (0: none) are drawn with ``rng`` (a
+    Generator, or a seed: the default 0 makes a fit reproducible). ``label`` names the
+    shots in error messages (default: Shots' file). The shots are taken in one order (by
+    speed, outcome, weight), so the fit and its bootstrap do not depend on the order
+    given.
 
     Raises :class:`~plateimpact.base.errors.V50Error` (one line) for fewer than 4 shots
     (weights counted), only one outcome, outcomes separated by a speed (the likelihood
@@ -135,7 +155,7 @@ def fit_v50(
     """
     link = link_of(method)
     _check_options(confidence, bootstrap)
-    v, y, w = check_arrays(speed, perforated, weight)
+    v, y, w, label = go_no_go(speed, perforated, weight, label)
     # One order whatever the file's: the same numbers, bootstrap draws included.
     order = np.lexsort((w, y, v))
     v, y, w = v[order], y[order], w[order]

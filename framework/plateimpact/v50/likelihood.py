@@ -29,10 +29,13 @@ import numpy as np
 from scipy import special
 
 from ..base.errors import ParameterError, V50Error
+from ..storage.shots import Shots
 
 #: The fits, by name.
 PROBIT, LOGIT = "probit", "logit"
 METHODS = (PROBIT, LOGIT)
+#: The label of shots given as arrays, in messages.
+SHOTS = "shots"
 #: Fewest shots (rounds: weights counted) a fit takes: two parameters and something left
 #: over.
 MIN_SHOTS = 4
@@ -150,6 +153,28 @@ def check_arrays(
             "weight", f"weights must be in [0, {MAX_WEIGHT:g}] (the shots a row stands for)"
         )
     return v, y.astype(bool), w
+
+
+def go_no_go(
+    speed: np.ndarray | Shots, perforated: object, weight: object | None, label: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """Speeds [m/s], outcomes and weights as :func:`check_arrays` gives them, and the
+    shots' label: from the arrays, or from :class:`~plateimpact.Shots` given alone (at one
+    obliquity: their ``perforated`` and ``weight``, labelled by their file unless
+    ``label`` is given)."""
+    if isinstance(speed, Shots):
+        if perforated is not None or weight is not None:
+            raise ParameterError(
+                "perforated",
+                "give Shots alone (their perforated and weight are used), or speed, "
+                "perforated and weight as arrays",
+            )
+        shots = speed.at_one_obliquity("a V50")
+        found = check_arrays(shots.impact_speed, shots.perforated, shots.weight)
+        return (*found, shots.source if label == SHOTS else label)
+    if perforated is None:
+        raise ParameterError("perforated", "perforated is needed with speeds: one per shot")
+    return (*check_arrays(speed, perforated, weight), label)
 
 
 def rounds(weight: np.ndarray) -> int | float:

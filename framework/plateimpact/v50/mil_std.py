@@ -21,7 +21,9 @@ import attrs
 import numpy as np
 
 from ..base.errors import ParameterError, V50Error
-from .likelihood import check_arrays
+from ..storage.shots import Shots
+from . import views
+from .likelihood import SHOTS, go_no_go
 
 #: Shots of each outcome the standard averages (four-, six- and ten-round limits).
 COUNTS = (2, 3, 5)
@@ -31,7 +33,7 @@ DEFAULT_SPREAD = 125 * 0.3048
 SPREAD_RANGE = (0.01, 1000.0)
 
 
-@attrs.frozen(eq=False)
+@attrs.frozen(eq=False, repr=False)
 class MilStd662F:
     """A MIL-STD-662F V50 [m/s]: the mean of the ``count`` highest partial penetrations
     (``partial_speeds_m_s``, fastest first) and the ``count`` lowest complete
@@ -52,6 +54,12 @@ class MilStd662F:
     def rounds(self) -> int:
         """The shots averaged (a 4-, 6- or 10-round ballistic limit)."""
         return 2 * self.count
+
+    def __repr__(self) -> str:
+        return views.mil_std_repr(self)
+
+    def _repr_html_(self) -> str:
+        return views.mil_std_html(self)
 
     def to_json(self) -> dict[str, Any]:
         """JSON values in m/s; speeds and indices as lists."""
@@ -75,24 +83,25 @@ def _rounds(weight: np.ndarray) -> np.ndarray:
 
 
 def mil_std_662f(
-    speed: np.ndarray,
-    perforated: np.ndarray,
+    speed: np.ndarray | Shots,
+    perforated: np.ndarray | None = None,
     weight: np.ndarray | None = None,
     *,
     spread_m_s: float = DEFAULT_SPREAD,
     count: int | None = None,
-    label: str = "shots",
+    label: str = SHOTS,
 ) -> MilStd662F:
     """The MIL-STD-662F V50 of go/no-go shots: ``speed`` [m/s], ``perforated`` (bool;
     a non-perforation is a partial penetration) and ``weight`` (whole numbers: a row of
-    weight 2 is two rounds at that speed; default 1) per shot.
+    weight 2 is two rounds at that speed; default 1) per shot; or ``speed`` is
+    :class:`~plateimpact.Shots` alone, at one obliquity (``used`` then indexes them).
 
     ``count`` (2, 3 or 5) partial and as many complete penetrations are averaged; None
     takes the most that lie within ``spread_m_s`` [m/s] (default 38.1 m/s, 125 ft/s).
     Raises :class:`~plateimpact.base.errors.V50Error` (one line naming the shots ``label``)
     when the shots do not meet the standard's conditions.
     """
-    v, y, w = check_arrays(speed, perforated, weight)
+    v, y, w, label = go_no_go(speed, perforated, weight, label)
     low, high = SPREAD_RANGE
     if not low <= spread_m_s <= high:  # NaN fails too
         raise ParameterError(
