@@ -132,6 +132,7 @@ _SUBMODULES: dict[str, str] = {
     "batch": "model.batch",
     "calibration": "calibration",
     "command_line": "cli.toolkit",
+    "display": "base.display",
     "experiment": "experiment",
     "geometry": "model.geometry",
     "kernels": "model.kernels",
@@ -199,6 +200,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # what type checkers and IDEs see
     from . import calibration, experiment, units, v50
+    from .base import display
     from .base.errors import (
         ArchiveError,
         ArchiveWaitWarning,

@@ -77,7 +77,7 @@ def cell(declared: Parameter, value: float | None, digits: int = 6, style: str =
 
 def spread(
     declared: Parameter,
-    values: np.ndarray,
+    values: np.ndarray | Sequence[float],
     with_unit: bool = True,
     digits: int = 6,
     style: str = "g",

@@ -22,6 +22,7 @@ from plateimpact import (
     fit_dri,
 )
 
+from . import fit_views
 from .ab_start import (
     check_start,
     energy_balance_start,
@@ -98,6 +99,9 @@ class Calibration:
     dri_mismatch: float
     rms_residual: float
 
+    __repr__ = fit_views.calibration_repr
+    _repr_html_ = fit_views.calibration_html
+
     @property
     def a(self) -> float:
         """Fitted strength term a [N/m²]."""
@@ -117,6 +121,9 @@ class CalibrationReport:
     dri: DriFit
     newton: Calibration
     direct: Calibration
+
+    __repr__ = fit_views.report_repr
+    _repr_html_ = fit_views.report_html
 
 
 def newton_fit(

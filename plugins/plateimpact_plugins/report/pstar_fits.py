@@ -24,6 +24,7 @@ from plateimpact import (
     limits,
 )
 
+from . import fit_views
 from .presets import DEFAULT_SPHERE
 from .pstar_plan import MAX_FIT_SCENES, check_work, unfittable
 from .pstar_search import (
@@ -125,6 +126,9 @@ class PstarFit:
     note: str
     cost: Cost
 
+    __repr__ = fit_views.pstar_repr
+    _repr_html_ = fit_views.pstar_html
+
     @property
     def pstar(self) -> float:
         """P* [m]."""
@@ -219,6 +223,9 @@ class PstarTableFit:
     alpha: float
     model: ProbabilityModel
     cost: Cost
+
+    __repr__ = fit_views.table_repr
+    _repr_html_ = fit_views.table_html
 
     def csv_text(self) -> str:
         """The table as the ``variable-pstar`` plug-in reads it, with the standard
