@@ -7,16 +7,7 @@ import math
 import attrs
 import numpy as np
 
-from ..base.display import (
-    SPEED,
-    cell,
-    heading,
-    html_block,
-    html_fields,
-    html_table,
-    quantity,
-    short_repr,
-)
+from ..base import display
 from ..base.errors import CalibrationError, ParameterError
 from ..storage.shots import Shots
 
@@ -61,25 +52,28 @@ class DriFit:
         return float(np.sqrt(np.mean(self.residuals**2)))
 
     def __repr__(self) -> str:
+        speed, quantity = display.SPEED, display.quantity
         parts = [
             f"R {self.R:.5g} +/- {self.R_stderr:.2g}",
-            f"V0 {cell(SPEED, self.V0, 5)} +/- {quantity(SPEED, self.V0_stderr, 2)}",
+            f"V0 {display.cell(speed, self.V0, 5)} +/- {quantity(speed, self.V0_stderr, 2)}",
             f"{self.impact_speed.size:,} perforating shots",
-            f"rms residual {quantity(SPEED, self.rms_residual, 3)}",
+            f"rms residual {quantity(speed, self.rms_residual, 3)}",
         ]
-        return short_repr("DriFit", parts)
+        return display.short_repr("DriFit", parts)
 
     def _repr_html_(self) -> str:
+        speed, cell = display.SPEED, display.cell
         rows = [
             ["R", f"{self.R:.5g}", f"{self.R_stderr:.2g}"],
-            [heading("V0", SPEED), cell(SPEED, self.V0, 5), cell(SPEED, self.V0_stderr, 2)],
+            [display.heading("V0", speed), cell(speed, self.V0, 5), cell(speed, self.V0_stderr, 2)],
         ]
         fields = [
             ("perforating shots", f"{self.impact_speed.size:,}"),
-            (heading("rms residual", SPEED), cell(SPEED, self.rms_residual, 3)),
+            (display.heading("rms residual", speed), cell(speed, self.rms_residual, 3)),
         ]
-        tables = html_table(["", "estimate", "standard error"], rows), html_fields(fields)
-        return html_block("DriFit: Vr = R (Vs^2 - V0^2)^(1/2) (eq 40)", *tables)
+        table = display.html_table(["", "estimate", "standard error"], rows)
+        title = "DriFit: Vr = R (Vs^2 - V0^2)^(1/2) (eq 40)"
+        return display.html_block(title, table, display.html_fields(fields))
 
     def residual_speed(self, impact_speed: np.ndarray | float) -> np.ndarray:
         """The fitted curve, eq 40 [m/s], 0 below the ballistic limit; ``impact_speed`` [m/s]."""
