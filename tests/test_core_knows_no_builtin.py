@@ -29,7 +29,7 @@ CORE = ROOT / "framework" / "plateimpact"
 
 #: Words that are a built-in's name and also plain English where the core uses them.
 PLAIN_WORDS = {
-    ("storage/netcdf.py", "intact"): "the CF flag meaning of plate_failed = 0 (a state)",
+    ("model/tables.py", "intact"): "the CF flag meaning of plate_failed = 0 (a state)",
 }
 
 

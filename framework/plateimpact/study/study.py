@@ -308,10 +308,16 @@ class StudyResults:
     ) -> None:
         self.study = study
         self.runs = dict(runs)
-        self.inputs = SceneInputs(study.scenes.columns, dict(constants or {}), study.plate_labels)
+        self.constants = dict(constants or {})
         for run in self.runs.values():
-            if len(run) == study.scenes.size:
+            if isinstance(study, Study) and len(run) == study.scenes.size:
                 run.inputs = self.inputs
+
+    @property
+    def inputs(self) -> SceneInputs:
+        """The study's scenes [SI], their plate constants' declarations and plate labels."""
+        study = self.study
+        return SceneInputs(study.scenes.columns, self.constants, study.plate_labels)
 
     @classmethod
     def from_archive(
