@@ -88,12 +88,12 @@ def spread(
     distinct = np.unique(np.asarray(values, dtype=float))
     if distinct.size == 0:
         return "none"
-    shown = [cell(declared, float(x), digits, style) for x in distinct]
-    if len(shown) > LISTED_VALUES:
-        text = f"{shown[0]} to {shown[-1]}"
-        suffix = f" ({len(shown)} values)"
+    if distinct.size > LISTED_VALUES:  # the ends only: a million values need no text each
+        low, high = (cell(declared, float(x), digits, style) for x in distinct[[0, -1]])
+        text, suffix = f"{low} to {high}", f" ({distinct.size:,} values)"
     else:
-        text, suffix = ", ".join(shown), ""
+        text = ", ".join(cell(declared, float(x), digits, style) for x in distinct)
+        suffix = ""
     shown_unit = unit(declared) if with_unit else ""
     return f"{text} {shown_unit}".rstrip() + suffix
 
