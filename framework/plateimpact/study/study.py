@@ -288,10 +288,10 @@ class Study:
                     except ArchiveBusyError as exc:  # the run was saved aside: say where
                         warnings.warn(str(exc), ArchiveWaitWarning, stacklevel=2)
         # the plate constants' units for the results' tables: as the archive has them
-        declared = {}
+        declarations: dict[str, Parameter] = {}
         for simulation in simulations.values():
-            declared.update(simulation.registry.plate_constants)
-        return StudyResults(self, runs, constants={**declared, **constants})
+            declarations.update(simulation.registry.plate_constants)
+        return StudyResults(self, runs, constants={**declarations, **constants})
 
 
 class StudyResults:
@@ -356,11 +356,15 @@ class StudyResults:
         scene): the plate, the inputs and the results in user units, each column named
         with its unit (``impact_obliquity_deg``, ``exit_speed_m_s``), the outcome by
         name; any study, grid or not. Plate constants as ``registry`` declares them
-        (an entry point of the API: without one, the installed plug-ins'). pandas is
-        needed (``pip install 'plateimpact[review]'``)."""
-        registry = default_registry() if registry is None else registry
+        (an entry point of the API: without one, as the study's run declared them, else
+        as the installed plug-ins do). pandas is needed (``pip install
+        'plateimpact[review]'``)."""
+        if registry is not None:
+            constants = registry.plate_constants
+        else:
+            constants = self.constants or default_registry().plate_constants
         study = self.study
-        inputs = SceneInputs(study.scenes.columns, registry.plate_constants, study.plate_labels)
+        inputs = SceneInputs(study.scenes.columns, constants, study.plate_labels)
         columns = [run.columns for run in self.runs.values()]
         table = scene_table(inputs, study.scenes.size, columns, list(self.runs))
         return table.to_dataframe()
