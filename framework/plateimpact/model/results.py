@@ -85,7 +85,7 @@ class Trajectory:
     failure_state: dict[str, np.ndarray] = attrs.field(factory=dict)
     outcome: Outcome | None = attrs.field(default=None, kw_only=True)
 
-    def _parts(self) -> list[tuple[str, str]]:
+    def _parts(self) -> list[views.PathPart]:
         columns = {name: np.asarray(getattr(self, name)) for name in TRAJECTORY_FIELDS}
         return views.trajectory_parts(columns, self.outcome, list(self.failure_state))
 

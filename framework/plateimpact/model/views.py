@@ -27,6 +27,7 @@ from ..base.display import (
     quantity,
     short_repr,
     spread,
+    unit,
 )
 from ..base.parameters import Parameter
 from .fields import CORE_COLUMNS, CRATER_FIELDS, RESULT_FIELDS, TRAJECTORY_FIELDS, Outcome
@@ -41,6 +42,11 @@ ROW_RESULTS: tuple[tuple[str, Parameter], ...] = (
 )
 #: The scene columns a row of a table shows, impact first.
 ROW_INPUTS = ("impact_speed", "impact_obliquity")
+
+
+def scenes(size: int) -> str:
+    """``1 scene``, ``1,000 scenes``."""
+    return f"{size:,} scene" + ("" if size == 1 else "s")
 
 
 def label(name: str) -> str:
@@ -93,43 +99,58 @@ def result_html(values: Mapping[str, Any]) -> str:
     return html_block("Result", html_fields(fields))
 
 
-def _ends(declared: Parameter, values: np.ndarray) -> str:
-    """``200 to 22.2 m/s``: a path's first and last value."""
-    if values.size == 0:
-        return "none"
-    return f"{cell(declared, values[0])} to {quantity(declared, values[-1])}"
+#: A path's facts: (what, its declaration or None for a label, the values shown: the
+#: first and last, or the one).
+PathPart = tuple[str, Parameter | None, tuple[float, ...] | str]
 
 
 def trajectory_parts(
     columns: Mapping[str, np.ndarray], outcome: Outcome | None, state: Sequence[str]
-) -> list[tuple[str, str]]:
-    """(what, value) of a recorded path: samples, time span, outcome, and where its
-    speed, obliquity and penetration went; never the arrays."""
-    time, samples = columns["time"], int(np.size(columns["time"]))
-    path = TRAJECTORY_FIELDS
-    parts = [
-        ("samples", f"{samples:,}"),
-        ("time", _ends(DURATION, time)),
-        ("outcome", "not given" if outcome is None else outcome.label),
-        ("speed", _ends(path["speed"], columns["speed"])),
-        ("obliquity", _ends(path["obliquity"], columns["obliquity"])),
+) -> list[PathPart]:
+    """What a recorded path says: samples, time span, outcome, and where its speed,
+    obliquity and penetration went; never the arrays."""
+    path, samples = TRAJECTORY_FIELDS, int(np.size(columns["time"]))
+    parts: list[PathPart] = [
+        ("samples", None, f"{samples:,}"),
+        ("time", DURATION, ()),
+        ("outcome", None, "not given" if outcome is None else outcome.label),
+        ("speed", path["speed"], ()),
+        ("obliquity", path["obliquity"], ()),
     ]
     if samples:
+        ends = {name: (float(columns[name][0]), float(columns[name][-1]))
+                for name in ("time", "speed", "obliquity")}  # fmt: skip
+        parts = [(what, d, ends.get(what, shown)) for what, d, shown in parts]
         deepest = float(np.max(columns["penetration"]))
-        parts.append(("max penetration", quantity(path["penetration"], deepest)))
+        parts.append(("max penetration", path["penetration"], (deepest,)))
     if state:
-        parts.append(("failure state", ", ".join(state)))
+        parts.append(("failure state", None, ", ".join(state)))
     return parts
 
 
-def trajectory_repr(parts: list[tuple[str, str]]) -> str:
-    (_, samples), (_, time), (_, outcome), *rest = parts
-    first = [f"{samples} samples over {time}", outcome]
-    return short_repr("Trajectory", [*first, *(f"{k} {v}" for k, v in rest)])
+def _shown(declared: Parameter | None, values: tuple[float, ...] | str, units: bool) -> str:
+    """A path's value: a label as it is, else its ends (``200 to 22.2 m/s``, or the unit
+    left to a heading), ``none`` for a path of no samples."""
+    if isinstance(values, str) or declared is None:
+        return str(values)
+    if not values:
+        return "none"
+    text = " to ".join(cell(declared, v) for v in values)
+    return f"{text} {unit(declared)}".rstrip() if units else text
 
 
-def trajectory_html(parts: list[tuple[str, str]]) -> str:
-    return html_block("Trajectory", html_fields(parts))
+def trajectory_repr(parts: list[PathPart]) -> str:
+    texts = {what: _shown(d, shown, units=True) for what, d, shown in parts}
+    first = [f"{texts.pop('samples')} samples over {texts.pop('time')}", texts.pop("outcome")]
+    return short_repr("Trajectory", [*first, *(f"{k} {v}" for k, v in texts.items())])
+
+
+def trajectory_html(parts: list[PathPart]) -> str:
+    fields: list[tuple[str, object]] = [
+        (what if d is None else heading(what, d), _shown(d, shown, units=False))
+        for what, d, shown in parts
+    ]
+    return html_block("Trajectory", html_fields(fields))
 
 
 def crater_repr(lateral: np.ndarray, depth: np.ndarray) -> str:
@@ -223,7 +244,7 @@ def rows_table(
 def batch_result_repr(
     size: int, columns: Mapping[str, np.ndarray], inputs: SceneInputs | None, kept: list[str]
 ) -> str:
-    parts = [f"{size:,} scenes: {counted(outcome_counts(columns))}"]
+    parts = [f"{scenes(size)}: {counted(outcome_counts(columns))}"]
     parts += inputs_parts(inputs) if inputs is not None else ["inputs not attached"]
     if kept:
         parts.append(f"with {' and '.join(kept)}")
@@ -239,7 +260,7 @@ def batch_result_html(
                              caption="outcomes"))  # fmt: skip
     tables.append(rows_table(size, inputs, columns))
     with_kept = f", with {' and '.join(kept)}" if kept else ""
-    return html_block(f"BatchResult: {size:,} scenes{with_kept}", *tables)
+    return html_block(f"BatchResult: {scenes(size)}{with_kept}", *tables)
 
 
 def scenes_repr(size: int, inputs: SceneInputs) -> str:
@@ -247,19 +268,19 @@ def scenes_repr(size: int, inputs: SceneInputs) -> str:
     sphere = [f"{label(n)} {spread(inputs.declared(n), inputs.columns[n])}"
               for n in ("radius", "mass", "thickness") if n in inputs.columns]  # fmt: skip
     listed = f"plate constants {', '.join(constants)}" if constants else ""
-    return short_repr("SceneBatch", [f"{size:,} scenes", *inputs_parts(inputs), *sphere, listed])
+    return short_repr("SceneBatch", [scenes(size), *inputs_parts(inputs), *sphere, listed])
 
 
 def scenes_html(size: int, inputs: SceneInputs) -> str:
     tables = [inputs_table(inputs), rows_table(size, inputs, None)]
-    return html_block(f"SceneBatch: {size:,} scenes", *tables)
+    return html_block(f"SceneBatch: {scenes(size)}", *tables)
 
 
 def runs_repr(
     kind: str, name: str, size: int, inputs: SceneInputs, runs: Mapping[str, Mapping[str, Any]]
 ) -> str:
     """A study's runs: how many over how many scenes, the impacts, each run's outcomes."""
-    parts = [f"{name!r}: {len(runs)} runs over {size:,} scenes", *inputs_parts(inputs)]
+    parts = [f"{name!r}: {len(runs)} runs over {scenes(size)}", *inputs_parts(inputs)]
     parts += [f"{run}: {counted(outcome_counts(columns))}" for run, columns in runs.items()]
     return short_repr(kind, parts)
 
@@ -277,4 +298,4 @@ def runs_html(
     rows = [[run, *(f"{n:,}" for _, n in found)] for run, found in counts.items()]
     tables = [html_fields([("description", description)])] if description else []
     tables += [inputs_table(inputs), html_table(header, rows, caption="outcomes of each run")]
-    return html_block(f"{kind} {name}: {len(runs)} runs over {size:,} scenes", *tables)
+    return html_block(f"{kind} {name}: {len(runs)} runs over {scenes(size)}", *tables)
