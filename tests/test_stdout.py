@@ -32,6 +32,11 @@ DRIVER = textwrap.dedent(
     import plateimpact.figures.limits_and_maps, plateimpact.figures.validation_panels
     import plateimpact.figures.v50_fits
     build_parser()
+    # the compiled programs loaded once, here: each child inherits them rather than
+    # importing numba and loading a program from the cache again
+    from plateimpact.registry.plugin_registry import default_registry
+    from plateimpact.solve.compiled.warming import compile_pairs, compiled_pairs
+    compile_pairs(compiled_pairs(default_registry()))
     # What is imported stays out of the collector's reach: a child then exits in a
     # tenth of the time (Python's finalisation otherwise walks, and copies, every page
     # of the parent's heap) and still flushes the standard output it sets up below.
