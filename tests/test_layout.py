@@ -215,7 +215,12 @@ def test_every_package_directory_is_installed():
         tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
     )
     roots = {"plateimpact": CORE, "plateimpact_plugins": ROOT / "plugins" / "plateimpact_plugins"}
-    found = {"plateimpact_studies"}
+    found = {"plateimpact_studies"}  # and its folders of data files, packages to setuptools
+    found |= {
+        f"plateimpact_studies.{folder.name}"
+        for folder in (ROOT / "studies").iterdir()
+        if folder.is_dir() and not folder.name.startswith(("_", "."))
+    }
     for package, root in roots.items():
         for init in root.rglob("__init__.py"):
             parts = init.parent.relative_to(root).parts
