@@ -8,12 +8,14 @@ one place (:mod:`plateimpact.base.units`)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from ..base.display import ANGLE, DURATION, LENGTH, number, quantity, unit, user
 from ..base.untrusted import printable
 from ..model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 
-__all__ = ["ANGLE", "AXES", "DURATION", "IMPACT_OBLIQUITY", "IMPACT_SPEED", "LENGTH", "number",
-           "quantity", "shown", "unit", "user"]  # fmt: skip
+__all__ = ["ANGLE", "AXES", "DURATION", "IMPACT_OBLIQUITY", "IMPACT_SPEED", "LENGTH", "interval",
+           "number", "quantity", "shown", "unit", "user"]  # fmt: skip
 
 #: Longest piece of a file's text printed [characters] (a longer one is cut, "...").
 LONGEST_TEXT = 200
@@ -26,3 +28,12 @@ def shown(value: object, limit: int | None = LONGEST_TEXT) -> str:
     """Text from a file (an archive's, a shot file's), as one inert line of at most
     ``limit`` characters."""
     return printable(value, limit)
+
+
+def interval(ends: Sequence[float | None] | None) -> str:
+    """A confidence interval as ``v50`` prints it: ``[low, high]`` to 4 digits,
+    ``unbounded`` for an end the data do not bound (None), ``-`` for none at all."""
+    if ends is None:
+        return "-"
+    low, high = ("unbounded" if x is None else f"{x:.4g}" for x in ends)
+    return f"[{low}, {high}]"

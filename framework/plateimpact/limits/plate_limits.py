@@ -212,7 +212,10 @@ def line_of(
 ) -> LimitLine:
     """Line ``index`` of what :func:`~.bracketing.locate` found, as a :class:`LimitLine`
     along ``axis`` over ``span`` at the other coordinate ``fixed``."""
-    mine = found.line == index
+    # the brackets are sorted by line: a line's are one slice (found in log time, so
+    # that reading every line of a many-line search costs no more than the lines)
+    start, stop = np.searchsorted(found.line, [index, index + 1])
+    mine = slice(int(start), int(stop))
     boundaries = tuple(
         Boundary(float(lo), float(hi), Regime.of_code(b), Regime.of_code(a))
         for lo, hi, b, a in zip(

@@ -11,13 +11,12 @@ from typing import Any
 
 import attrs
 import numpy as np
-from scipy import stats
 
 from ..model.batch import SceneBatch
 from ..model.results import BatchResult
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
-from .propagation import OUTCOMES, sample_inputs, scenes
+from .propagation import OUTCOMES, binomial_intervals, sample_inputs, scenes
 from .spec import UncertaintySpec, UncertaintySpecError
 
 #: The most scenes a curve or map runs (samples × points) unless asked otherwise.
@@ -41,16 +40,10 @@ class OutcomeGrid:
 
     def intervals(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Each probability's exact binomial interval at every point (low, high)."""
-        out = {}
-        for name, count in self.counts.items():
-            low, high = np.empty(count.shape), np.empty(count.shape)
-            for index, k in np.ndenumerate(count):
-                ci = stats.binomtest(int(k), self.samples).proportion_ci(
-                    self.confidence, method="exact"
-                )
-                low[index], high[index] = ci.low, ci.high
-            out[name] = (low, high)
-        return out
+        return {
+            name: binomial_intervals(count, self.samples, self.confidence)
+            for name, count in self.counts.items()
+        }
 
     def to_json(self) -> dict[str, Any]:
         intervals = self.intervals()

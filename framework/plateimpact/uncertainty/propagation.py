@@ -76,8 +76,8 @@ class Propagation:
         n = self.result.outcome.size
         out = {}
         for name, count in self.counts.items():
-            ci = stats.binomtest(count, n).proportion_ci(self.confidence, method="exact")
-            out[name] = (float(ci.low), float(ci.high))
+            low, high = binomial_intervals(np.array(count), n, self.confidence)
+            out[name] = (float(low), float(high))
         return out
 
     def exit_quantiles(self, levels: tuple[float, ...] = (0.05, 0.5, 0.95)) -> dict[str, Any]:
@@ -111,6 +111,19 @@ class Propagation:
             "exit_quantiles": self.exit_quantiles(),
             "spec": self.spec.describe(),
         }
+
+
+def binomial_intervals(
+    counts: np.ndarray, n: int, confidence: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The exact (Clopper–Pearson) interval of each proportion ``counts`` / ``n`` at
+    ``confidence`` (``scipy.stats.binomtest``): arrays (low, high) of ``counts``' shape."""
+    counts = np.asarray(counts)
+    low, high = np.empty(counts.shape), np.empty(counts.shape)
+    for index, k in np.ndenumerate(counts):
+        ci = stats.binomtest(int(k), n).proportion_ci(confidence, method="exact")
+        low[index], high[index] = ci.low, ci.high
+    return low, high
 
 
 def sample_inputs(spec: UncertaintySpec) -> dict[str, np.ndarray]:
@@ -190,11 +203,16 @@ def propagate(
     return Propagation(spec, inputs, result, confidence)
 
 
+def spec_digest(spec: UncertaintySpec, **more: Any) -> str:
+    """The SHA-256 of ``spec`` as described (and of ``more``, JSON values: what else
+    a result depends on), not of where it was read from: the same spec, the same digest."""
+    described = {**spec.describe(), "source": "", **more}
+    return hashlib.sha256(json.dumps(described, sort_keys=True).encode()).hexdigest()
+
+
 def study_name(spec: UncertaintySpec) -> str:
     """The archive's name for the study of ``spec``: the same spec, the same name."""
-    described = {**spec.describe(), "source": ""}  # where it was read from does not matter
-    digest = hashlib.sha256(json.dumps(described, sort_keys=True).encode()).hexdigest()
-    return f"uncertainty-{digest[:12]}"
+    return f"uncertainty-{spec_digest(spec)[:12]}"
 
 
 def _archived(

@@ -11,6 +11,7 @@ perforates (whose variance is P(1 − P)), or each sample's ballistic limit."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import Executor
 from typing import Any
 
 import attrs
@@ -20,6 +21,7 @@ from ..model.results import Outcome
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
 from .distributions import Distribution
+from .limit_search import RESOLUTION, SPEEDS, TOLERANCE, line_limits, sample_scenes
 from .propagation import EDGE, scenes
 from .spec import UncertaintySpec, UncertaintySpecError
 
@@ -106,19 +108,25 @@ def sobol_indices(
     )
 
 
+def _independent(spec: UncertaintySpec) -> None:
+    if spec.correlations:
+        raise UncertaintySpecError(
+            f"{spec.source}: correlations: Sobol' indices need independent inputs"
+        )
+
+
 def perforation_indices(
     spec: UncertaintySpec,
     registry: PluginRegistry,
     base_samples: int,
     *,
     simulation: Simulation | None = None,
+    executor: Executor | None = None,
 ) -> SobolIndices:
     """Sobol' indices of whether a sample perforates (its mean is P(perforation)) at the
-    spec's condition, to each of the spec's uncertain inputs."""
-    if spec.correlations:
-        raise UncertaintySpecError(
-            f"{spec.source}: correlations: Sobol' indices need independent inputs"
-        )
+    spec's condition, to each of the spec's uncertain inputs (``executor``: where the
+    batch runs, in chunks, with the same bits)."""
+    _independent(spec)
     if simulation is None:
         simulation = Simulation.from_names(failure=spec.failure, registry=registry)
     run = simulation
@@ -126,6 +134,51 @@ def perforation_indices(
     def perforates(values: dict[str, np.ndarray]) -> np.ndarray:
         n = next(iter(values.values())).size
         batch = scenes(attrs.evolve(spec, samples=n), values, registry)
-        return (run.run_batch(batch).outcome == Outcome.PERFORATION).astype(float)
+        outcome = run.run_batch(batch, executor=executor).outcome
+        return (outcome == Outcome.PERFORATION).astype(float)
 
     return sobol_indices(dict(spec.inputs), perforates, base_samples, spec.seed)
+
+
+def ballistic_limit_indices(
+    spec: UncertaintySpec,
+    registry: PluginRegistry,
+    base_samples: int,
+    *,
+    speeds: tuple[float, float] = SPEEDS,
+    tolerance: float = TOLERANCE,
+    resolution: float = RESOLUTION,
+    simulation: Simulation | None = None,
+    executor: Executor | None = None,
+) -> SobolIndices:
+    """Sobol' indices of the ballistic limit [m/s] (each Saltelli point's, found by the
+    limits finder over ``speeds`` at the spec's obliquity, or at the point's own where
+    the obliquity is uncertain) to each of the spec's uncertain inputs. The speed takes
+    no distribution (the limit is a speed); a point whose limit is outside the range is
+    refused, naming how many (an index of a quantity that is not a number is none)."""
+    if "speed_m_s" in spec.inputs:
+        raise UncertaintySpecError(
+            f"{spec.source}: inputs.speed_m_s: the ballistic limit is a speed: its Sobol' "
+            "indices take the speed without a distribution (give it in at, or leave it out)"
+        )
+    _independent(spec)
+    if simulation is None:
+        simulation = Simulation.from_names(failure=spec.failure, registry=registry)
+    run = simulation
+
+    def limits(values: dict[str, np.ndarray]) -> np.ndarray:
+        base = sample_scenes(spec, values, registry, speeds)
+        found = line_limits(
+            base, np.arange(base.size), base.columns["impact_obliquity"], run,
+            speeds=speeds, tolerance=tolerance, resolution=resolution, executor=executor,
+        )  # fmt: skip
+        outside = int(np.sum(~np.isfinite(found.ballistic)))
+        if outside:
+            raise UncertaintySpecError(
+                f"{spec.source}: {outside:,} of {base.size:,} Saltelli points have no "
+                f"ballistic limit in {speeds[0]:g}-{speeds[1]:g} m/s (they perforate at "
+                "every speed of it or at none): narrow the inputs' distributions"
+            )
+        return found.ballistic
+
+    return sobol_indices(dict(spec.inputs), limits, base_samples, spec.seed)

@@ -21,7 +21,7 @@ from ...v50 import COUNTS, DEFAULT_SPREAD, METHODS, MilStd662F, V50Fit, fit_v50,
 from ...v50.fit import DEFAULT_BOOTSTRAP
 from ...v50.likelihood import shown as count_shown
 from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
-from ..formatting import number, shown, user
+from ..formatting import interval, number, shown, user
 from ..options import add_body_options, add_model_options, bodies, model_choice, typed
 from ..writer import Writer
 
@@ -273,13 +273,6 @@ def _json(
     return row
 
 
-def _interval(interval: list[float | None] | None) -> str:
-    if interval is None:
-        return "-"
-    low, high = ("unbounded" if x is None else f"{x:.4g}" for x in interval)
-    return f"[{low}, {high}]"
-
-
 def _text(row: dict[str, Any]) -> str:
     where = f"{shown(row['shots_file'], None)} at {row['obliquity_deg']:g} deg"
     if "error" in row:
@@ -304,8 +297,8 @@ def _text(row: dict[str, Any]) -> str:
             + (f" | bootstrap ({resamples} resamples)" if resamples else "")
         ]
         for name, key in (("V50", "v50"), ("sigma", "sigma"), ("V10", "v10"), ("V90", "v90")):
-            boot = f"  {_interval(row[f'{key}_bootstrap_ci_m_s'])}" if resamples else ""
-            profile = _interval(row[f"{key}_ci_m_s"])
+            boot = f"  {interval(row[f'{key}_bootstrap_ci_m_s'])}" if resamples else ""
+            profile = interval(row[f"{key}_ci_m_s"])
             lines.append(f"  {name:6s}{row[f'{key}_m_s']:9.4g} m/s  {profile}{boot}")
         low, high = row["mixed_zone_m_s"]
         note = f"zone of mixed results {low:g}-{high:g} m/s"
