@@ -271,8 +271,12 @@ def test_the_command_prints_the_limits_quantiles(tmp_path, capsys):
     path.write_text(json.dumps(pstar_only(40)))
     assert main(["uncertainty", str(path), "--limits", "--json"]) == 0
     said = json.loads(capsys.readouterr().out)
-    assert said["samples"] == 40 and said["obliquity_deg"] == 0.0
-    assert said["V10"]["speed_m_s"] < said["V50"]["speed_m_s"] < said["V90"]["speed_m_s"]
+    (row,) = said["limits"]
+    assert said["samples"] == 40 and row["obliquity_deg"] == 0.0
+    ballistic = row["ballistic_limit"]  # the keys of plateimpact v50
+    assert ballistic["v10_m_s"] < ballistic["v50_m_s"] < ballistic["v90_m_s"]
+    low, high = ballistic["v50_ci_m_s"]
+    assert low <= ballistic["v50_m_s"] <= high
     assert said["spec"]["inputs"] == {"pstar_mm": {"uniform": {"low": 2.5, "high": 3.5}}}
 
 
@@ -324,7 +328,7 @@ def test_the_command_prints_sobol_indices_and_draws_their_bars(tmp_path, capsys)
     path.write_text(json.dumps(given))
     argv = ["uncertainty", str(path), "--sobol", "64", "--png", str(png), "--dpi", "50", "--json"]
     assert main(argv) == 0
-    said = json.loads(capsys.readouterr().out)
+    said = json.loads(capsys.readouterr().out)["perforation"]
     assert said["evaluations"] == 64 * 4 and set(said["indices"]) == {"speed_m_s", "pstar_mm"}
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -333,7 +337,10 @@ def test_the_command_prints_sobol_indices_and_draws_their_bars(tmp_path, capsys)
     "extra, said",
     [
         (["--sobol", "100"], "--sobol: a power of 2"),
-        (["--png", "x.png"], "--png draws the Sobol' indices: give --sobol N too"),
+        (["--png", "x.png"], "--png draws the limits' curves, the Sobol' indices or the"),
+        (["--sobol", "64", "--limits"], "--sobol: not with --limits"),
+        (["--sobol-of", "both"], "--sobol-of says what --sobol N analyses"),
+        (["--sobol", "64", "--sobol-of", "ballistic_limit"], "inputs.speed_m_s without a"),
     ],
 )
 def test_the_command_refuses_bad_sobol_flags_in_one_line(tmp_path, capsys, extra, said):
@@ -510,8 +517,9 @@ def test_the_command_keeps_an_archived_run_unless_resumed(tmp_path, capsys):
     [
         (["--samples", "1"], "--samples: an integer in [2, 10,000,000]"),
         (["--seed", "-1"], "--seed: an integer in [0, 2**63)"),
-        (["--resume"], "--resume reads back a run of --archive"),
-        (["--archive", "u.h5", "--limits"], "--archive: the outcome probabilities only"),
+        (["--resume"], "--resume reads back a result of --archive"),
+        (["--archive", "u.h5", "--shots", "s.csv"], "--shots go beside the sampled limits"),
+        (["--archive", "u.h5", "--limits", "--speeds", "300"], "--speeds: not with --limits"),
         (["--speeds", "a:b:c"], "--speeds"),
     ],
 )

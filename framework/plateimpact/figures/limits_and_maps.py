@@ -79,7 +79,7 @@ def plot_bands(found: Limits, label: str) -> Figure:
     return fig
 
 
-def _cell_edges(centres: np.ndarray) -> np.ndarray:
+def cell_edges(centres: np.ndarray) -> np.ndarray:
     """The edges of cells centred on ``centres`` (increasing): half-way between
     neighbours, half a spacing beyond the ends (``shading="nearest"``)."""
     middles = (centres[1:] + centres[:-1]) / 2.0
@@ -96,7 +96,7 @@ def _draw_map(ax: Axes, found: OutcomeMap) -> set[Regime]:
     norm = BoundaryNorm(np.arange(len(REGIMES) + 1) - 0.5, len(REGIMES))
     # One image (nearest cells; uneven rows make a rectilinear image), a raster in SVG and
     # PDF too: thousands of cells drawn as one bitmap, not as thousands of paths.
-    ax.pcolorfast(_cell_edges(found.speeds), _cell_edges(found.obliquities / _DEG), index,
+    ax.pcolorfast(cell_edges(found.speeds), cell_edges(found.obliquities / _DEG), index,
                   cmap=cmap, norm=norm)  # fmt: skip
     for _, _, xs, ys in found.boundary_curves():  # located to the tolerance, not the grid
         ax.plot(xs, ys / _DEG, color="k", lw=0.8)

@@ -9,6 +9,7 @@ and return them; :func:`figure` gives a figure and its axes.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from typing import Any
 
@@ -57,3 +58,14 @@ def regime_colour(regime: Regime) -> str:
 def regime_key(regimes: Sequence[Regime] | set[Regime]) -> list[Patch]:
     """Legend handles: one coloured patch per regime present, in the order of REGIMES."""
     return [Patch(color=regime_colour(r), label=r.label) for r in REGIMES if r in regimes]
+
+
+def small_print(fig: Figure, text: str, width: float) -> None:
+    """What produced ``fig`` (plate, model, samples, version), in small grey print along
+    its foot, wrapped to its ``width`` [in]; a strip is kept for it below what the
+    layout engine places (a figure drawn with ``layout="constrained"``)."""
+    lines = textwrap.fill(text, int(width * 21))  # some 21 5-pt characters per inch
+    strip = ((lines.count("\n") + 1) * (SMALL - 1) * 1.3 / 72.0 + 0.04) / fig.get_figheight()
+    fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))  # type: ignore[union-attr, call-arg]
+    fig.text(0.5, 0.01 / fig.get_figheight(), lines, fontsize=SMALL - 1, color="0.35",
+             ha="center", va="bottom")  # fmt: skip

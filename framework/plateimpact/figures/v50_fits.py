@@ -52,18 +52,42 @@ def _span(panel: Panel) -> tuple[float, float]:
     return low - pad, high + pad
 
 
+def draw_fit(
+    ax: Axes, estimate: V50Fit, low: float, high: float, colour: str = FIT_COLOUR,
+    what: str = "",
+) -> None:  # fmt: skip
+    """The fitted curve over [``low``, ``high``] [m/s], its V50 marked and the V50's
+    profile interval shaded; ``what`` goes before the legend's labels (whose fit)."""
+    ci_low, ci_high = estimate.v50_ci_m_s
+    ax.axvspan(low if ci_low is None else ci_low, high if ci_high is None else ci_high,
+               color=BAND_COLOUR, alpha=0.5, lw=0,
+               label=f"{what}V50 {100 * estimate.confidence:g}% interval (profile)")  # fmt: skip
+    speeds = np.linspace(low, high, CURVE_POINTS)
+    ax.plot(speeds, estimate.probability(speeds), color=colour, lw=1.2,
+            label=f"{what}{estimate.method} fit")  # fmt: skip
+    ax.axvline(estimate.v50_m_s, color=colour, lw=0.6, ls=":")
+
+
+def draw_shots(
+    ax: Axes, speed: np.ndarray, perforated: np.ndarray, weight: np.ndarray,
+    rng: np.random.Generator,
+) -> None:  # fmt: skip
+    """Each shot of positive weight at 0 or 1 (jittered a little inward, so that shots at
+    one speed stay apart): triangles perforated, circles not."""
+    shown = weight > 0
+    y = perforated.astype(float)
+    jitter = rng.uniform(0.0, JITTER, y.size) * np.where(perforated, -1.0, 1.0)
+    for kind, marker, label in ((True, "^", "perforated"), (False, "o", "not perforated")):
+        mask = shown & (perforated == kind)
+        ax.plot(speed[mask], (y + jitter)[mask], marker, ms=3.5, mfc="none", mec="k",
+                ls="none", label=label)  # fmt: skip
+
+
 def _draw(ax: Axes, panel: Panel, rng: np.random.Generator) -> None:
     low, high = _span(panel)
     estimate = panel.estimate
     if isinstance(estimate, V50Fit):
-        ci_low, ci_high = estimate.v50_ci_m_s
-        ax.axvspan(low if ci_low is None else ci_low, high if ci_high is None else ci_high,
-                   color=BAND_COLOUR, alpha=0.5, lw=0,
-                   label=f"V50 {100 * estimate.confidence:g}% interval (profile)")  # fmt: skip
-        speeds = np.linspace(low, high, CURVE_POINTS)
-        ax.plot(speeds, estimate.probability(speeds), color=FIT_COLOUR, lw=1.2,
-                label=f"{estimate.method} fit")  # fmt: skip
-        ax.axvline(estimate.v50_m_s, color=FIT_COLOUR, lw=0.6, ls=":")
+        draw_fit(ax, estimate, low, high)
         title = (f"{panel.title}: V50 {estimate.v50_m_s:.4g} m/s, "
                  f"σ {estimate.sigma_m_s:.3g} m/s")  # fmt: skip
     elif isinstance(estimate, MilStd662F):
@@ -87,13 +111,7 @@ def _draw(ax: Axes, panel: Panel, rng: np.random.Generator) -> None:
         ax.axvline(panel.model_ballistic_limit, color=MODEL_COLOUR, lw=1.0, ls="--",
                    label="model's ballistic limit")  # fmt: skip
         title += f"\nmodel's ballistic limit {panel.model_ballistic_limit:.4g} m/s"
-    shown = panel.weight > 0
-    y = panel.perforated.astype(float)
-    jitter = rng.uniform(0.0, JITTER, y.size) * np.where(panel.perforated, -1.0, 1.0)
-    for perforated, marker, label in ((True, "^", "perforated"), (False, "o", "not perforated")):
-        mask = shown & (panel.perforated == perforated)
-        ax.plot(panel.speed[mask], (y + jitter)[mask], marker, ms=3.5, mfc="none", mec="k",
-                ls="none", label=label)  # fmt: skip
+    draw_shots(ax, panel.speed, panel.perforated, panel.weight, rng)
     ax.set_xlim(low, high)
     ax.set_ylim(-0.08, 1.08)
     ax.set_title(title, fontsize=FONT)

@@ -1,31 +1,22 @@
 """``plateimpact uncertainty``: distributions on a scene's inputs, propagated by direct
 simulation: the probability of each outcome with its confidence interval, and exit-speed
-and exit-obliquity quantiles (docs/uncertainty.md)."""
+and exit-obliquity quantiles; or the sampled ballistic and ricochet limits
+(cli.uncertainty_limits), Sobol' indices, curves and maps (cli.uncertainty_modes)
+(docs/uncertainty.md)."""
 
 from __future__ import annotations
 
 import argparse
 import json
 
-from ...model.bodies import THICKNESS
-from ...provenance.metadata import versions
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
 from ...run.simulation import Simulation
 from ...uncertainty import propagate, read_spec
-from ...uncertainty.curves import outcome_grid
-from ...uncertainty.limits import sampled_limits
-from ...uncertainty.sensitivity import perforation_indices
-from ...uncertainty.spec import (
-    MAX_SAMPLES,
-    METHODS,
-    UncertaintySpec,
-    UncertaintySpecError,
-    with_settings,
-)
-from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
-from ..formatting import quantity
-from ..limit_options import values
+from ...uncertainty.spec import MAX_SAMPLES, METHODS, with_settings
+from ..common import UsageError, add_dpi_option, check_directory
+from ..uncertainty_limits import limits
+from ..uncertainty_modes import SOBOL_OF, grid, provenance, sobol
 from ..writer import Writer
 
 
@@ -45,19 +36,39 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
     p.add_argument(
         "--limits",
         action="store_true",
-        help="find the ballistic limit of every sample at the spec's obliquity instead "
-        "(the speed takes no distribution): V10, V50 and V90 with distribution-free 95%% "
-        "intervals, the whole P(perforation | V) curve from one set of limits",
+        help="find the ballistic and ricochet limits of every sample at each obliquity of "
+        "--obliquities (or the spec's) instead (the speed takes no distribution): V10, V50, "
+        "V90 and sigma of each limit with distribution-free 95%% intervals, as v50 reports "
+        "them; the whole P(perforation | V) and P(ricochet | V) curves from one set of limits",
+    )
+    p.add_argument(
+        "--shots",
+        metavar="SHOTS.csv",
+        help="with --limits: go/no-go shots (the file v50 reads), fitted as v50 fits them "
+        "(probit) at each obliquity they share with the limits, printed beside the model's "
+        "and drawn on the same axes by --png",
     )
     p.add_argument(
         "--sobol",
         type=int,
         metavar="N",
-        help="instead: Sobol' first-order and total indices of perforation at the spec's "
-        "condition to each uncertain input, from N x (inputs + 2) runs (N a power of 2, "
-        "in [16, 1,048,576])",
+        help="instead: Sobol' first-order and total indices at the spec's condition to each "
+        "uncertain input, from N x (inputs + 2) evaluations (N a power of 2, in "
+        "[16, 1,048,576])",
     )
-    p.add_argument("--png", metavar="FILE", help="with --sobol: draw the indices as bars")
+    p.add_argument(
+        "--sobol-of",
+        choices=SOBOL_OF,
+        help="with --sobol: of whether a sample perforates (perforation, the default), of its "
+        "ballistic limit at the spec's obliquity (ballistic_limit: the speed takes no "
+        "distribution), or both",
+    )
+    p.add_argument(
+        "--png",
+        metavar="FILE",
+        help="draw: with --limits the velocity-response curves, with --sobol the indices as "
+        "bars, with --speeds and --obliquities the probability maps",
+    )
     p.add_argument(
         "--speeds",
         metavar="SPEEDS",
@@ -67,19 +78,45 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
     p.add_argument(
         "--obliquities",
         metavar="ANGLES",
-        help="the same along obliquity [deg] (with --speeds: over the plane)",
+        help="the same along obliquity [deg] (with --speeds: over the plane); with --limits: "
+        "the obliquities of the limits",
     )
     p.add_argument(
         "--archive",
         metavar="FILE",
-        help="run the samples as a study of this archive (HDF5 index and netCDF runs): the "
-        "samples, the spec and the model recorded; outcome probabilities only",
+        help="keep the result in this HDF5 archive: the samples run as a study (the samples, "
+        "the spec and the model recorded), the limits, indices and maps as records beside it",
     )
     p.add_argument(
-        "--resume", action="store_true", help="with --archive: read back the same spec's run"
+        "--resume",
+        action="store_true",
+        help="with --archive: read back the same request's finished result instead of computing it",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_dpi_option(p)
+
+
+def _check_flags(args: argparse.Namespace) -> None:
+    """The flags that go together, refused in one line before any scene runs."""
+    if args.resume and args.archive is None:
+        raise UsageError("--resume reads back a result of --archive: give --archive FILE too")
+    grid = args.speeds is not None or args.obliquities is not None
+    if args.sobol is not None:
+        others = {"--limits": args.limits, "--speeds": args.speeds is not None,
+                  "--obliquities": args.obliquities is not None}  # fmt: skip
+        given = [flag for flag, on in others.items() if on]
+        if given:
+            raise UsageError(f"--sobol: not with {', '.join(given)} (one result at a time)")
+    elif args.sobol_of is not None:
+        raise UsageError("--sobol-of says what --sobol N analyses: give --sobol N too")
+    if args.shots is not None and not args.limits:
+        raise UsageError("--shots go beside the sampled limits: give --limits too")
+    if args.png is not None and not (args.limits or args.sobol is not None or grid):
+        raise UsageError(
+            "--png draws the limits' curves, the Sobol' indices or the probability maps: give "
+            "--limits, --sobol N, or --speeds and --obliquities"
+        )
+    check_directory(args.png, "--png", "figure")
 
 
 def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
@@ -93,29 +130,21 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         seed=spec.seed if args.seed is None else args.seed,
         names=("--samples", "--method", "--seed"),
     )
+    _check_flags(args)
     simulation = Simulation.from_names(failure=spec.failure, registry=registry)
-    others = args.limits or args.sobol is not None or args.speeds or args.obliquities
-    if args.archive is not None and others:
-        raise UsageError(
-            "--archive: the outcome probabilities only (not --limits, --sobol, --speeds or "
-            "--obliquities)"
-        )
-    if args.resume and args.archive is None:
-        raise UsageError("--resume reads back a run of --archive: give --archive FILE too")
-    if args.png is not None and args.sobol is None:
-        raise UsageError("--png draws the Sobol' indices: give --sobol N too")
-    check_directory(args.png, "--png", "figure")
     if args.sobol is not None:
-        return _sobol(spec, simulation, args, out)
-    if args.speeds is not None or args.obliquities is not None:
-        return _grid(spec, simulation, args, out)
+        if args.sobol_of is None:
+            args.sobol_of = "perforation"
+        return sobol(spec, simulation, args, out)
     if args.limits:
-        return _limits(spec, simulation, args, out)
+        return limits(spec, simulation, args, out)
+    if args.speeds is not None or args.obliquities is not None:
+        return grid(spec, simulation, args, out)
     with reporting_scenes("uncertainty", spec.samples):
         found = propagate(
             spec, registry, simulation=simulation, archive=args.archive, resume=args.resume
         )
-    summary = {**found.to_json(), **_provenance(simulation)}
+    summary = {**found.to_json(), **provenance(simulation)}
     if args.json:
         out.say(json.dumps(summary, indent=2))
         return 0
@@ -135,98 +164,4 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         if quantiles[key] is not None:
             values = ", ".join(f"{v:.4g}" for v in quantiles[key])
             out.say(f"  {label}, quantiles {levels}%: {values}")
-    return 0
-
-
-def _provenance(simulation: Simulation) -> dict[str, object]:
-    """What produced the numbers: the model's plug-ins with their settings, and versions."""
-    return {"model": simulation.describe(), "versions": versions()}
-
-
-def _limits(
-    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
-) -> int:
-    registry = simulation.registry
-    as_json = args.json
-    if "obliquity_deg" in spec.inputs:
-        raise UncertaintySpecError(
-            f"{spec.source}: obliquity_deg: --limits finds limits at one obliquity: give it in at"
-        )
-    with reporting_scenes("uncertainty --limits"):
-        found = sampled_limits(spec, registry, spec.at["obliquity_deg"], simulation=simulation)
-    summary = {**found.to_json(), "spec": spec.describe(), **_provenance(simulation)}
-    if as_json:
-        out.say(json.dumps(summary, indent=2))
-        return 0
-    out.say(
-        f"{spec.source}: ballistic limit of {spec.samples:,} samples ({spec.method}, seed "
-        f"{spec.seed}) at {summary['obliquity_deg']:g} deg"
-    )
-    for name in ("V10", "V50", "V90"):
-        q = summary[name]
-        out.say(
-            f"  {name} = {q['speed_m_s']:.1f} m/s   95% [{q['low_m_s']:.1f}, {q['high_m_s']:.1f}]"
-        )
-    beyond, below = summary["beyond_range"], summary["below_range"]
-    if beyond or below:
-        out.say(f"  {beyond} sample(s) never perforate in the range, {below} always do")
-    return 0
-
-
-def _sobol(
-    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
-) -> int:
-    registry = simulation.registry
-    base = args.sobol
-    if not (16 <= base <= 2**20 and base & (base - 1) == 0):
-        raise UsageError(f"--sobol: a power of 2 in [16, {2**20:,}], got {base}")
-    if len(spec.inputs) < 2:
-        raise UncertaintySpecError(f"{spec.source}: inputs: --sobol needs two or more")
-    with reporting_scenes("uncertainty --sobol", base * (len(spec.inputs) + 2)):
-        found = perforation_indices(spec, registry, base, simulation=simulation)
-    if args.png is not None:
-        from ...figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
-
-        thickness = quantity(THICKNESS, spec.plate.thickness, 3)
-        title = f"{spec.plate.material}, {thickness}: perforation"
-        save_figure_atomically(plot_sobol_indices(found, title), args.png, dpi=args.dpi)
-    summary = {**found.to_json(), "spec": spec.describe(), **_provenance(simulation)}
-    if args.json:
-        out.say(json.dumps(summary, indent=2))
-        return 0
-    out.say(f"{spec.source}: Sobol' indices of perforation, {found.evaluations:,} runs")
-    for name, index in summary["indices"].items():
-        first, total = index["first_interval"], index["total_interval"]
-        out.say(
-            f"  {name:14s} S1 {index['first']:6.3f} [{first[0]:6.3f}, {first[1]:6.3f}]   "
-            f"ST {index['total']:6.3f} [{total[0]:6.3f}, {total[1]:6.3f}]"
-        )
-    out.say(f"  dominant: {found.dominant()}")
-    if args.png is not None:
-        out.say(f"figure: {args.png}")
-    return 0
-
-
-def _grid(
-    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
-) -> int:
-    registry = simulation.registry
-    speeds = None if args.speeds is None else values(args.speeds, "--speeds", "m/s")
-    angles = None if args.obliquities is None else values(args.obliquities, "--obliquities", "deg")
-    with reporting_scenes("uncertainty"):
-        found = outcome_grid(spec, registry, speeds, angles, simulation=simulation)
-    summary = {**found.to_json(), **_provenance(simulation)}
-    if args.json:
-        out.say(json.dumps(summary, indent=2))
-        return 0
-    probability, (low, high) = found.probabilities(), found.intervals()["perforation"]
-    out.say(f"{spec.source}: {spec.samples:,} samples at each point; P(perforation), 95%")
-    out.say("speed_m_s  obliquity_deg  P(ricochet)  P(embedment)  P(perforation)  [low, high]")
-    for i, v in enumerate(found.speeds_m_s):
-        for j, o in enumerate(found.obliquities_deg):
-            out.say(
-                f"{v:9.4g}  {o:13.4g}  {probability['ricochet'][i, j]:11.4f}  "
-                f"{probability['embedment'][i, j]:12.4f}  "
-                f"{probability['perforation'][i, j]:14.4f}  [{low[i, j]:.4f}, {high[i, j]:.4f}]"
-            )
     return 0

@@ -1,0 +1,233 @@
+"""What ``plateimpact uncertainty`` does besides propagating one condition: Sobol'
+indices (of P(perforation) and of the ballistic limit) and probability curves and maps
+over a grid of speeds and obliquities, each kept in ``--archive`` and read back on
+``--resume``; and what every mode shares (provenance, the archive, the figure's small
+print). The limits mode is cli.uncertainty_limits."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+import numpy as np
+
+from ..model.bodies import THICKNESS
+from ..provenance.metadata import versions
+from ..run.progress import reporting_scenes
+from ..run.simulation import Simulation
+from ..storage.archive import Archive
+from ..storage.records import LIMITS
+from ..uncertainty.archived import (
+    KIND_INDICES,
+    KIND_MAP,
+    code_record,
+    indices_from_record,
+    indices_to_record,
+    kept_or_computed,
+    map_from_record,
+    map_to_record,
+    record_name,
+)
+from ..uncertainty.curves import outcome_grid
+from ..uncertainty.limit_search import RESOLUTION, SPEEDS, TOLERANCE
+from ..uncertainty.sensitivity import SobolIndices, ballistic_limit_indices, perforation_indices
+from ..uncertainty.spec import UncertaintySpec, UncertaintySpecError
+from .common import UsageError, save_figure_atomically
+from .formatting import quantity, shown
+from .limit_options import values
+from .writer import Writer
+
+#: What --sobol-of may ask for.
+SOBOL_OF = ("perforation", "ballistic_limit", "both")
+#: The settings of every sampled-limit search (the finder's defaults for sampled limits).
+SEARCH = {"speeds_m_s": list(SPEEDS), "tolerance_m_s": TOLERANCE, "resolution_m_s": RESOLUTION}
+
+
+def provenance(simulation: Simulation) -> dict[str, object]:
+    """What produced the numbers: the model's plug-ins with their settings, and versions."""
+    return {"model": simulation.describe(), "versions": versions()}
+
+
+def figure_provenance(
+    spec: UncertaintySpec, simulation: Simulation, sampled: str | None = None
+) -> str:
+    """A figure's small print: the plate, the model, how the inputs were sampled (by
+    default the spec's samples) and the version."""
+    model = simulation.describe()
+    thickness = quantity(THICKNESS, spec.plate.thickness, 3)
+    inputs = ", ".join(spec.inputs) or "no input"
+    if sampled is None:
+        sampled = f"{spec.samples:,} samples ({spec.method}, seed {spec.seed})"
+    return (
+        f"{spec.plate.material} {thickness}; {model['resistance']} + {model['failure']}, "
+        f"{model['integrator']}; {sampled} of {inputs} from {spec.source}; plateimpact "
+        f"{versions().get('plateimpact')}"
+    )
+
+
+def plate_title(spec: UncertaintySpec) -> str:
+    return f"{spec.plate.material}, {quantity(THICKNESS, spec.plate.thickness, 3)}"
+
+
+def archive_of(args: argparse.Namespace) -> Archive | None:
+    return None if args.archive is None else Archive(args.archive)
+
+
+def stored(archive: Archive | None, name: str, out: Writer) -> str | None:
+    """Say where the result is kept; its name in the archive (None: no archive)."""
+    if archive is None:
+        return None
+    out.say(f"archive: {shown(archive.path, None)} ({LIMITS}/{name})")
+    return f"{LIMITS}/{name}"
+
+
+def check_sobol(spec: UncertaintySpec, args: argparse.Namespace) -> tuple[int, list[str]]:
+    """--sobol N and --sobol-of, checked before any scene runs."""
+    base = args.sobol
+    if not (16 <= base <= 2**20 and base & (base - 1) == 0):
+        raise UsageError(f"--sobol: a power of 2 in [16, {2**20:,}], got {base}")
+    quantities = ["perforation", "ballistic_limit"] if args.sobol_of == "both" else [args.sobol_of]
+    if "ballistic_limit" in quantities and "speed_m_s" in spec.inputs:
+        raise UsageError(
+            f"--sobol-of {args.sobol_of}: the ballistic limit is a speed: its indices take "
+            f"inputs.speed_m_s without a distribution (give it in at); {spec.source} gives it one"
+        )
+    if "perforation" in quantities and not ("speed_m_s" in spec.at or "speed_m_s" in spec.inputs):
+        raise UncertaintySpecError(
+            f"{spec.source}: speed_m_s: P(perforation) is at a speed: give it in at or in inputs "
+            "(or --sobol-of ballistic_limit)"
+        )
+    if len(spec.inputs) < 2:
+        raise UncertaintySpecError(f"{spec.source}: inputs: --sobol needs two or more")
+    return base, quantities
+
+
+def sobol(
+    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
+) -> int:
+    registry = simulation.registry
+    base, quantities = check_sobol(spec, args)
+    searched = "ballistic_limit" in quantities
+    settings: dict[str, Any] = {"base_samples": base, "quantities": quantities}
+    if searched:
+        settings.update(SEARCH)
+    archive = archive_of(args)
+    name = record_name(spec, KIND_INDICES, settings)
+
+    def compute() -> dict[str, SobolIndices]:
+        runs = base * (len(spec.inputs) + 2)
+        found = {}
+        with reporting_scenes("uncertainty --sobol", None if searched else runs):
+            if "perforation" in quantities:
+                found["perforation"] = perforation_indices(spec, registry, base,
+                                                           simulation=simulation)  # fmt: skip
+            if searched:
+                found["ballistic_limit"] = ballistic_limit_indices(
+                    spec, registry, base, simulation=simulation
+                )
+        return found
+
+    found = kept_or_computed(
+        archive, name, resume=args.resume, code=code_record(simulation, searched), spec=spec,
+        compute=compute, to_record=lambda f: indices_to_record(f, spec, simulation, settings),
+        from_record=indices_from_record,
+    )  # fmt: skip
+    if args.png is not None:
+        from ..figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
+
+        sampled = f"Saltelli's points, N = {base} (seed {spec.seed})"
+        small = figure_provenance(spec, simulation, sampled)
+        figure = plot_sobol_indices(found, plate_title(spec), small)
+        save_figure_atomically(figure, args.png, dpi=args.dpi)
+    summary: dict[str, Any] = {"base_samples": base}
+    summary |= {q: indices.to_json() for q, indices in found.items()}
+    summary |= {"spec": spec.describe(), **provenance(simulation)}
+    if args.json:
+        out.say(json.dumps({**summary, "archive_record": _record(archive, name)}, indent=2))
+        return 0
+    where = f"at {spec.at['obliquity_deg']:g} deg" if "obliquity_deg" in spec.at else ""
+    for quantity_name, indices in found.items():
+        what = (
+            f"perforation, {indices.evaluations:,} runs"
+            if quantity_name == "perforation"
+            else f"the ballistic limit {where}, {indices.evaluations:,} limits".replace("  ", " ")
+        )
+        out.say(f"{spec.source}: Sobol' indices of {what}")
+        for input_name, index in summary[quantity_name]["indices"].items():
+            first, total = index["first_interval"], index["total_interval"]
+            out.say(
+                f"  {input_name:14s} S1 {index['first']:6.3f} [{first[0]:6.3f}, {first[1]:6.3f}]"
+                f"   ST {index['total']:6.3f} [{total[0]:6.3f}, {total[1]:6.3f}]"
+            )
+        out.say(f"  dominant: {indices.dominant()}")
+    stored(archive, name, out)
+    if args.png is not None:
+        out.say(f"figure: {args.png}")
+    return 0
+
+
+def _record(archive: Archive | None, name: str) -> str | None:
+    return None if archive is None else f"{LIMITS}/{name}"
+
+
+def check_grid(args: argparse.Namespace) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """--speeds and --obliquities; with --png, two or more of each (a map)."""
+    speeds = None if args.speeds is None else values(args.speeds, "--speeds", "m/s")
+    angles = None if args.obliquities is None else values(args.obliquities, "--obliquities", "deg")
+    if args.png is not None and (
+        speeds is None or angles is None or min(speeds.size, angles.size) < 2
+    ):
+        raise UsageError(
+            "--png draws probability maps over the (speed, obliquity) plane: give --speeds and "
+            "--obliquities two or more values each"
+        )
+    return speeds, angles
+
+
+def grid(
+    spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
+) -> int:
+    registry = simulation.registry
+    speeds, angles = check_grid(args)
+    archive = archive_of(args)
+    settings = {
+        "speeds_m_s": None if speeds is None else speeds.tolist(),
+        "obliquities_deg": None if angles is None else angles.tolist(),
+    }
+    name = record_name(spec, KIND_MAP, settings)
+
+    def compute() -> Any:
+        with reporting_scenes("uncertainty"):
+            return outcome_grid(spec, registry, speeds, angles, simulation=simulation)
+
+    found = kept_or_computed(
+        archive, name, resume=args.resume, code=code_record(simulation, False), spec=spec,
+        compute=compute, to_record=lambda f: map_to_record(f, simulation, settings),
+        from_record=lambda r, w: map_from_record(r, spec, w),
+    )  # fmt: skip
+    if args.png is not None:
+        from ..figures.probability_maps import plot_probability_maps  # noqa: PLC0415
+
+        figure = plot_probability_maps(
+            found, title=plate_title(spec), provenance=figure_provenance(spec, simulation)
+        )
+        save_figure_atomically(figure, args.png, dpi=args.dpi)
+    summary = {**found.to_json(), **provenance(simulation)}
+    if args.json:
+        out.say(json.dumps({**summary, "archive_record": _record(archive, name)}, indent=2))
+        return 0
+    probability, (low, high) = found.probabilities(), found.intervals()["perforation"]
+    out.say(f"{spec.source}: {spec.samples:,} samples at each point; P(perforation), 95%")
+    out.say("speed_m_s  obliquity_deg  P(ricochet)  P(embedment)  P(perforation)  [low, high]")
+    for i, v in enumerate(found.speeds_m_s):
+        for j, o in enumerate(found.obliquities_deg):
+            out.say(
+                f"{v:9.4g}  {o:13.4g}  {probability['ricochet'][i, j]:11.4f}  "
+                f"{probability['embedment'][i, j]:12.4f}  "
+                f"{probability['perforation'][i, j]:14.4f}  [{low[i, j]:.4f}, {high[i, j]:.4f}]"
+            )
+    stored(archive, name, out)
+    if args.png is not None:
+        out.say(f"figure: {args.png}")
+    return 0
