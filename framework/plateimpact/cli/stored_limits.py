@@ -6,10 +6,12 @@ import json
 import math
 
 from ..base.errors import UnknownNameError
+from ..base.untrusted import printable
 from ..limits import LimitsComparison, OutcomeMap, compare_limits, read_limits
 from ..limits.archived import KIND_MAP, NAMES, attributes_of
 from ..limits.lines import OBLIQUITY, SPEED, LimitLine
 from ..provenance.code import summary as code_summary
+from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.records import LIMITS
 from .common import UsageError
@@ -87,11 +89,49 @@ def _plate(plate: object) -> str:
     )
 
 
+#: The kinds of record an uncertainty study keeps (uncertainty.archived) start so.
+UNCERTAINTY = "uncertainty_"
+
+
+def uncertainty_lines(archive: Archive, name: str) -> list[str]:
+    """What an uncertainty study's record holds (sampled limits, Sobol' indices, a
+    probability map): the plate, the model, the spec's inputs and sampling, what made
+    it; its numbers are read with plateimpact.uncertainty.archived.read_stored."""
+    attributes = archive.record(name).attributes
+    what = f"archive {archive.path}: {LIMITS}/{printable(name)}"
+    kind = typed.text(attributes, "kind", what)
+    spec = typed.json_value(attributes, "spec", what, dict)
+    model = typed.json_value(attributes, "model", what, dict)
+    settings = typed.json_value(attributes, "settings", what, dict)
+    inputs = spec.get("inputs")
+    listed = ", ".join(shown(k) for k in inputs) if isinstance(inputs, dict) else shown(inputs)
+    versions = typed.json_value(attributes, "versions", what, dict)
+    return [
+        f"{LIMITS}/{shown(name, None)}: {shown(kind.removeprefix(UNCERTAINTY))} of an "
+        "uncertainty study",
+        f"  plate {_plate(typed.json_value(attributes, 'plate', what, dict))}",
+        f"  model: {_model(model)}",
+        f"  samples {shown(spec.get('samples'))} ({shown(spec.get('method'))}, seed "
+        f"{shown(spec.get('seed'))}) of {listed}; settings {shown(json.dumps(settings), 300)}",
+        f"  made {shown(attributes.get('creation_time'))} on {shown(attributes.get('host'))}, "
+        f"plateimpact {shown(versions.get('plateimpact'))}, commit "
+        f"{shown(str(attributes.get('git_commit'))[:12])}",
+        *(
+            f"  {line}"
+            for line in code_summary(typed.json_value(attributes, "plugins", what, dict))
+        ),
+    ]
+
+
 def show_stored(archive: Archive, out: Writer) -> None:
     """Print every stored limits and map: what, plate, model, tolerance and resolution,
     then one line per line with its named limits. Every piece of the archive's text is
     printed inert (describe.shown)."""
     for name in archive.limits_names():
+        kind = archive.record(name).attributes.get("kind")
+        if isinstance(kind, str) and kind.startswith(UNCERTAINTY):
+            out.say("\n".join(uncertainty_lines(archive, name)))
+            continue
         found = read_limits(archive, name)
         meta = attributes_of(archive, name)
         limits = found.limits if isinstance(found, OutcomeMap) else found

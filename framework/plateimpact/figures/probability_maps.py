@@ -24,20 +24,22 @@ def plot_probability_maps(found: OutcomeGrid, *, title: str, provenance: str) ->
                        sharey=True)  # fmt: skip
     probabilities = found.probabilities()
     speeds, degrees = found.speeds_m_s, found.obliquities_deg
-    image = None
+    images = []
     for ax, outcome in zip(axes, MAPPED, strict=True):
         values = probabilities[outcome].T  # rows: obliquities, columns: speeds
         image = ax.pcolormesh(cell_edges(speeds), cell_edges(degrees), values,
                               vmin=0.0, vmax=1.0, cmap="viridis")  # fmt: skip
-        if 0.0 < values.min() or values.max() > 0.0:
-            lines = ax.contour(speeds, degrees, values, levels=LEVELS, colors="w",
+        images.append(image)
+        crossed = [p for p in LEVELS if values.min() < p < values.max()]
+        if crossed:  # contours only where the probability crosses them
+            lines = ax.contour(speeds, degrees, values, levels=crossed, colors="w",
                                linewidths=0.7)  # fmt: skip
             ax.clabel(lines, fontsize=SMALL - 1, fmt=lambda p: f"{p:.1f}")
         ax.set_title(f"P({outcome})", fontsize=FONT)
         ax.set_xlabel("impact speed [m/s]", fontsize=FONT)
         ax.tick_params(labelsize=SMALL)
     axes[0].set_ylabel("impact obliquity [deg]", fontsize=FONT)
-    bar = fig.colorbar(image, ax=list(axes), shrink=0.9)
+    bar = fig.colorbar(images[0], ax=list(axes), shrink=0.9)
     bar.set_label("probability (fraction of the samples)", fontsize=FONT)
     bar.ax.tick_params(labelsize=SMALL)
     points = f"{speeds.size} x {degrees.size} points, {found.samples:,} samples at each"

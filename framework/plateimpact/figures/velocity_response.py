@@ -11,6 +11,7 @@ from collections.abc import Mapping, Sequence
 
 import attrs
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
@@ -110,7 +111,7 @@ def plot_velocity_response(
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
     for k, (ax, one) in enumerate(zip(axes, found, strict=False)):
         _draw(ax, one, shots.get(k), confidence)
-    key: dict[str, object] = {}  # one entry per kind of mark, from whichever panel has it
+    key: dict[str, Artist] = {}  # one entry per kind of mark, from whichever panel has it
     for ax in axes[: len(found)]:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             key.setdefault(label, handle)

@@ -308,6 +308,12 @@ def read_limits(
     where = _archive(archive)
     record = where.record(name)
     what = f"archive {where.path}: limits {printable(name)}"
+    kind = record.attributes.get("kind")
+    if isinstance(kind, str) and kind not in (KIND_LIMITS, KIND_MAP):  # another kind of record
+        raise ArchiveError(
+            f"{what} holds {printable(kind, 40)}, not limits or an outcome map "
+            "(plateimpact show describes it)"
+        )
     try:
         return from_record(record, what, registry)
     except ArchiveError:

@@ -216,16 +216,16 @@ def indices_from_record(record: Record, what: str) -> dict[str, SobolIndices]:
         names = tuple(
             str(n) for n in typed.json_value(attributes, f"{quantity}_inputs", what, list)
         )
-        arrays = [
+        first, first_half, total, total_half = (
             record.columns[f"{quantity}/{key}"].data
             for key in ("first", "first_halfwidth", "total", "total_halfwidth")
-        ]
-        if any(a.shape != (len(names),) for a in arrays):
+        )
+        if any(a.shape != (len(names),) for a in (first, first_half, total, total_half)):
             raise ArchiveError(
                 f"{what}: the indices of {printable(quantity)} are not one per input"
             )
         out[str(quantity)] = SobolIndices(
-            names, *arrays,
+            names, first, first_half, total, total_half,
             int(typed.number(attributes, f"{quantity}_evaluations", what)),
             typed.number(attributes, f"{quantity}_confidence", what),
         )  # fmt: skip

@@ -122,10 +122,12 @@ def perforation_indices(
     *,
     simulation: Simulation | None = None,
     executor: Executor | None = None,
+    confidence: float = 0.95,
 ) -> SobolIndices:
     """Sobol' indices of whether a sample perforates (its mean is P(perforation)) at the
     spec's condition, to each of the spec's uncertain inputs (``executor``: where the
-    batch runs, in chunks, with the same bits)."""
+    batch runs, in chunks, with the same bits), with bootstrap intervals at
+    ``confidence``."""
     _independent(spec)
     if simulation is None:
         simulation = Simulation.from_names(failure=spec.failure, registry=registry)
@@ -137,7 +139,9 @@ def perforation_indices(
         outcome = run.run_batch(batch, executor=executor).outcome
         return (outcome == Outcome.PERFORATION).astype(float)
 
-    return sobol_indices(dict(spec.inputs), perforates, base_samples, spec.seed)
+    return sobol_indices(
+        dict(spec.inputs), perforates, base_samples, spec.seed, confidence=confidence
+    )
 
 
 def ballistic_limit_indices(
@@ -150,6 +154,7 @@ def ballistic_limit_indices(
     resolution: float = RESOLUTION,
     simulation: Simulation | None = None,
     executor: Executor | None = None,
+    confidence: float = 0.95,
 ) -> SobolIndices:
     """Sobol' indices of the ballistic limit [m/s] (each Saltelli point's, found by the
     limits finder over ``speeds`` at the spec's obliquity, or at the point's own where
@@ -181,4 +186,4 @@ def ballistic_limit_indices(
             )
         return found.ballistic
 
-    return sobol_indices(dict(spec.inputs), limits, base_samples, spec.seed)
+    return sobol_indices(dict(spec.inputs), limits, base_samples, spec.seed, confidence=confidence)
