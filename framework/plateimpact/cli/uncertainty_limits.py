@@ -19,22 +19,14 @@ from ..model.scene import IMPACT_OBLIQUITY
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.shots import Shots
-from ..uncertainty.archived import (
-    KIND_LIMITS,
-    code_record,
-    kept_or_computed,
-    limits_from_record,
-    limits_to_record,
-    record_name,
-)
-from ..uncertainty.limits import OUTSIDE, SampledLimits, sampled_limits_at
+from ..uncertainty.kept import kept_limits
+from ..uncertainty.limits import OUTSIDE
 from ..uncertainty.spec import UncertaintySpec, UncertaintySpecError
 from ..v50 import V50Fit, fit_v50
 from .common import UsageError, save_figure_atomically
 from .formatting import interval, number, shown
 from .limit_options import values
 from .uncertainty_modes import (
-    SEARCH,
     archive_of,
     figure_provenance,
     plate_title,
@@ -166,19 +158,10 @@ def limits(
         if name in spec.at:  # the spec's own sphere, when it gives one
             sphere = attrs.evolve(sphere, **{declared.name: spec.at[name] * declared.scale})
     shots = {} if args.shots is None else _shots(args, spec, angles, sphere)
-    archive = archive_of(args)
-    settings = {"obliquities_deg": angles.tolist(), **SEARCH}
-    name = record_name(spec, KIND_LIMITS, settings)
-
-    def compute() -> tuple[SampledLimits, ...]:
-        with reporting_scenes("uncertainty --limits"):
-            return sampled_limits_at(spec, registry, angles, simulation=simulation)
-
-    found = kept_or_computed(
-        archive, name, resume=args.resume, code=code_record(simulation, True), spec=spec,
-        compute=compute, to_record=lambda f: limits_to_record(f, simulation, settings),
-        from_record=lambda r, w: limits_from_record(r, spec, registry, w),
-    )  # fmt: skip
+    with reporting_scenes("uncertainty --limits"):
+        found, kept = kept_limits(
+            spec, registry, angles, archive_of(args), resume=args.resume, simulation=simulation
+        )
     if args.png is not None:
         from ..figures.velocity_response import plot_velocity_response  # noqa: PLC0415
 
@@ -201,7 +184,7 @@ def limits(
             "samples": spec.samples, "method": spec.method, "seed": spec.seed,
             "confidence": 0.95, "search": first.search(), "limits": rows,
             "spec": spec.describe(), **provenance(simulation),
-            "archive_record": None if archive is None else f"limits/{name}",
+            "archive_record": kept.record,
         }  # fmt: skip
         out.say(json.dumps(summary, indent=2))
         return 0
@@ -218,7 +201,7 @@ def limits(
                 out.say(line)
             if limit == "ballistic" and k in shots:  # the shots beside the model's V50
                 out.say(_shots_text(args, shots[k]))
-    stored(archive, name, out)
+    stored(kept, out)
     if args.png is not None:
         out.say(f"figure: {args.png}")
     return 0

@@ -17,21 +17,7 @@ from ..provenance.metadata import versions
 from ..run.progress import reporting_scenes
 from ..run.simulation import Simulation
 from ..storage.archive import Archive
-from ..storage.records import LIMITS
-from ..uncertainty.archived import (
-    KIND_INDICES,
-    KIND_MAP,
-    code_record,
-    indices_from_record,
-    indices_to_record,
-    kept_or_computed,
-    map_from_record,
-    map_to_record,
-    record_name,
-)
-from ..uncertainty.curves import outcome_grid
-from ..uncertainty.limit_search import RESOLUTION, SPEEDS, TOLERANCE
-from ..uncertainty.sensitivity import SobolIndices, ballistic_limit_indices, perforation_indices
+from ..uncertainty.kept import Kept, kept_indices, kept_map
 from ..uncertainty.spec import UncertaintySpec, UncertaintySpecError
 from .common import UsageError, save_figure_atomically
 from .formatting import quantity, shown
@@ -40,8 +26,6 @@ from .writer import Writer
 
 #: What --sobol-of may ask for.
 SOBOL_OF = ("perforation", "ballistic_limit", "both")
-#: The settings of every sampled-limit search (the finder's defaults for sampled limits).
-SEARCH = {"speeds_m_s": list(SPEEDS), "tolerance_m_s": TOLERANCE, "resolution_m_s": RESOLUTION}
 
 
 def provenance(simulation: Simulation) -> dict[str, object]:
@@ -74,12 +58,10 @@ def archive_of(args: argparse.Namespace) -> Archive | None:
     return None if args.archive is None else Archive(args.archive)
 
 
-def stored(archive: Archive | None, name: str, out: Writer) -> str | None:
-    """Say where the result is kept; its name in the archive (None: no archive)."""
-    if archive is None:
-        return None
-    out.say(f"archive: {shown(archive.path, None)} ({LIMITS}/{name})")
-    return f"{LIMITS}/{name}"
+def stored(kept: Kept, out: Writer) -> None:
+    """Say where the result is kept, if it is."""
+    if kept.archive is not None:
+        out.say(f"archive: {shown(kept.archive.path, None)} ({kept.record})")
 
 
 def check_sobol(spec: UncertaintySpec, args: argparse.Namespace) -> tuple[int, list[str]]:
@@ -108,31 +90,12 @@ def sobol(
 ) -> int:
     registry = simulation.registry
     base, quantities = check_sobol(spec, args)
-    searched = "ballistic_limit" in quantities
-    settings: dict[str, Any] = {"base_samples": base, "quantities": quantities}
-    if searched:
-        settings.update(SEARCH)
-    archive = archive_of(args)
-    name = record_name(spec, KIND_INDICES, settings)
-
-    def compute() -> dict[str, SobolIndices]:
-        runs = base * (len(spec.inputs) + 2)
-        found = {}
-        with reporting_scenes("uncertainty --sobol", None if searched else runs):
-            if "perforation" in quantities:
-                found["perforation"] = perforation_indices(spec, registry, base,
-                                                           simulation=simulation)  # fmt: skip
-            if searched:
-                found["ballistic_limit"] = ballistic_limit_indices(
-                    spec, registry, base, simulation=simulation
-                )
-        return found
-
-    found = kept_or_computed(
-        archive, name, resume=args.resume, code=code_record(simulation, searched), spec=spec,
-        compute=compute, to_record=lambda f: indices_to_record(f, spec, simulation, settings),
-        from_record=indices_from_record,
-    )  # fmt: skip
+    runs = None if "ballistic_limit" in quantities else base * (len(spec.inputs) + 2)
+    with reporting_scenes("uncertainty --sobol", runs):
+        found, kept = kept_indices(
+            spec, registry, base, quantities, archive_of(args), resume=args.resume,
+            simulation=simulation,
+        )  # fmt: skip
     if args.png is not None:
         from ..figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
 
@@ -144,7 +107,7 @@ def sobol(
     summary |= {q: indices.to_json() for q, indices in found.items()}
     summary |= {"spec": spec.describe(), **provenance(simulation)}
     if args.json:
-        out.say(json.dumps({**summary, "archive_record": _record(archive, name)}, indent=2))
+        out.say(json.dumps({**summary, "archive_record": kept.record}, indent=2))
         return 0
     where = f"at {spec.at['obliquity_deg']:g} deg" if "obliquity_deg" in spec.at else ""
     for quantity_name, indices in found.items():
@@ -161,14 +124,10 @@ def sobol(
                 f"   ST {index['total']:6.3f} [{total[0]:6.3f}, {total[1]:6.3f}]"
             )
         out.say(f"  dominant: {indices.dominant()}")
-    stored(archive, name, out)
+    stored(kept, out)
     if args.png is not None:
         out.say(f"figure: {args.png}")
     return 0
-
-
-def _record(archive: Archive | None, name: str) -> str | None:
-    return None if archive is None else f"{LIMITS}/{name}"
 
 
 def check_grid(args: argparse.Namespace) -> tuple[np.ndarray | None, np.ndarray | None]:
@@ -188,24 +147,12 @@ def check_grid(args: argparse.Namespace) -> tuple[np.ndarray | None, np.ndarray 
 def grid(
     spec: UncertaintySpec, simulation: Simulation, args: argparse.Namespace, out: Writer
 ) -> int:
-    registry = simulation.registry
     speeds, angles = check_grid(args)
-    archive = archive_of(args)
-    settings = {
-        "speeds_m_s": None if speeds is None else speeds.tolist(),
-        "obliquities_deg": None if angles is None else angles.tolist(),
-    }
-    name = record_name(spec, KIND_MAP, settings)
-
-    def compute() -> Any:
-        with reporting_scenes("uncertainty"):
-            return outcome_grid(spec, registry, speeds, angles, simulation=simulation)
-
-    found = kept_or_computed(
-        archive, name, resume=args.resume, code=code_record(simulation, False), spec=spec,
-        compute=compute, to_record=lambda f: map_to_record(f, simulation, settings),
-        from_record=lambda r, w: map_from_record(r, spec, w),
-    )  # fmt: skip
+    with reporting_scenes("uncertainty"):
+        found, kept = kept_map(
+            spec, simulation.registry, speeds, angles, archive_of(args), resume=args.resume,
+            simulation=simulation,
+        )  # fmt: skip
     if args.png is not None:
         from ..figures.probability_maps import plot_probability_maps  # noqa: PLC0415
 
@@ -215,7 +162,7 @@ def grid(
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     summary = {**found.to_json(), **provenance(simulation)}
     if args.json:
-        out.say(json.dumps({**summary, "archive_record": _record(archive, name)}, indent=2))
+        out.say(json.dumps({**summary, "archive_record": kept.record}, indent=2))
         return 0
     probability, (low, high) = found.probabilities(), found.intervals()["perforation"]
     out.say(f"{spec.source}: {spec.samples:,} samples at each point; P(perforation), 95%")
@@ -227,7 +174,7 @@ def grid(
                 f"{probability['embedment'][i, j]:12.4f}  "
                 f"{probability['perforation'][i, j]:14.4f}  [{low[i, j]:.4f}, {high[i, j]:.4f}]"
             )
-    stored(archive, name, out)
+    stored(kept, out)
     if args.png is not None:
         out.say(f"figure: {args.png}")
     return 0
