@@ -9,10 +9,13 @@ and return them; :func:`figure` gives a figure and its axes.
 
 from __future__ import annotations
 
+import math
 import textwrap
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
@@ -69,3 +72,29 @@ def small_print(fig: Figure, text: str, width: float) -> None:
     fig.get_layout_engine().set(rect=(0.0, strip, 1.0, 1.0 - strip))  # type: ignore[union-attr, call-arg]
     fig.text(0.5, 0.01 / fig.get_figheight(), lines, fontsize=SMALL - 1, color="0.35",
              ha="center", va="bottom")  # fmt: skip
+
+
+def panel_grid(
+    count: int, panel_width: float, row_height: float, foot: float
+) -> tuple[Figure, np.ndarray]:
+    """A figure of ``count`` panels in rows of at most :data:`MAX_COLUMNS`, each
+    ``panel_width`` wide (the figure at most the page) and ``row_height`` high, with
+    ``foot`` [in] for a key and titles; its axes, flat."""
+    nrows = math.ceil(count / MAX_COLUMNS)
+    ncols = math.ceil(count / nrows)
+    fig = Figure(figsize=(min(PAGE_WIDTH, panel_width * ncols), row_height * nrows + foot),
+                 layout="constrained")  # fmt: skip
+    return fig, np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+
+
+def shared_key(fig: Figure, axes: np.ndarray, count: int) -> None:
+    """One key below the first ``count`` panels, one entry per kind of mark from
+    whichever panel has it; the panels beyond ``count`` hidden."""
+    key: dict[str, Artist] = {}
+    for ax in axes[:count]:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            key.setdefault(label, handle)
+    fig.legend(list(key.values()), list(key), loc="outside lower center", ncols=3,
+               fontsize=SMALL, frameon=False)  # fmt: skip
+    for ax in axes[count:]:
+        ax.set_visible(False)

@@ -3,19 +3,17 @@ of shots (matplotlib is imported only here)."""
 
 from __future__ import annotations
 
-import math
 import textwrap
 from collections.abc import Sequence
 
 import attrs
 import numpy as np
-from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..v50.fit import V50Fit
 from ..v50.mil_std import MilStd662F
-from .style import FONT, MAX_COLUMNS, PAGE_WIDTH, SMALL
+from .style import FONT, SMALL, panel_grid, shared_key
 
 #: Points of the fitted curve; shots are drawn this far off 0 and 1 at most (jitter, so
 #: that shots at one speed stay apart), seeded so the figure is the same each time.
@@ -124,21 +122,11 @@ def v50_figure(panels: Sequence[Panel], *, title: str = "", model: str | None = 
     """P(perforation) against impact speed, a panel per group: the shots at 0 and 1
     (jittered a little inward), the fitted curve with its V50 interval shaded (or the
     MIL-STD-662F V50 and the span of its rounds), and the model's ballistic limit dashed."""
-    nrows = math.ceil(len(panels) / MAX_COLUMNS)
-    ncols = math.ceil(len(panels) / nrows)
-    fig = Figure(figsize=(min(PAGE_WIDTH, 3.6 * ncols), 2.8 * nrows + 0.5), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    fig, axes = panel_grid(len(panels), 3.6, 2.8, 0.5)
     rng = np.random.default_rng(0)
     for ax, panel in zip(axes, panels, strict=False):
         _draw(ax, panel, rng)
-    key: dict[str, Artist] = {}  # one entry per kind of mark, from whichever panel has it
-    for ax in axes[: len(panels)]:
-        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            key.setdefault(label, handle)
-    fig.legend(list(key.values()), list(key), loc="outside lower center", ncols=3,
-               fontsize=SMALL, frameon=False)  # fmt: skip
-    for ax in axes[len(panels) :]:
-        ax.set_visible(False)
+    shared_key(fig, axes, len(panels))
     heading = f"{title}: probability of perforation" if title else "probability of perforation"
     if model:
         heading += f"; model {model}"

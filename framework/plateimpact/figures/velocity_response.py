@@ -11,14 +11,13 @@ from collections.abc import Mapping, Sequence
 
 import attrs
 import numpy as np
-from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..limits.regimes import REGIMES
 from ..uncertainty.limits import LEVELS, SampledLimits
 from ..v50.fit import V50Fit
-from .style import FONT, MAX_COLUMNS, PAGE_WIDTH, REGIME_COLOURS, SMALL, small_print
+from .style import FONT, PAGE_WIDTH, REGIME_COLOURS, SMALL, panel_grid, shared_key, small_print
 from .v50_fits import draw_fit, draw_shots
 
 #: Speeds at which a curve is evaluated (a step function: as many as a panel has pixels).
@@ -105,20 +104,10 @@ def plot_velocity_response(
     V10/V50/V90 marked; ``shots[k]``: the shots at obliquity ``k`` of ``found`` and their
     fit, drawn on the same axes; ``provenance`` in small print at the foot."""
     shots = shots or {}
-    nrows = math.ceil(len(found) / MAX_COLUMNS)
-    ncols = math.ceil(len(found) / nrows)
-    fig = Figure(figsize=(PAGE_WIDTH, 2.7 * nrows + 0.9), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    fig, axes = panel_grid(len(found), PAGE_WIDTH, 2.7, 0.9)  # the page, one panel or more
     for k, (ax, one) in enumerate(zip(axes, found, strict=False)):
         _draw(ax, one, shots.get(k), confidence)
-    key: dict[str, Artist] = {}  # one entry per kind of mark, from whichever panel has it
-    for ax in axes[: len(found)]:
-        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            key.setdefault(label, handle)
-    fig.legend(list(key.values()), list(key), loc="outside lower center", ncols=3,
-               fontsize=SMALL, frameon=False)  # fmt: skip
-    for ax in axes[len(found) :]:
-        ax.set_visible(False)
+    shared_key(fig, axes, len(found))
     fig.suptitle(title, fontsize=FONT)
     small_print(fig, provenance, PAGE_WIDTH)
     return fig
