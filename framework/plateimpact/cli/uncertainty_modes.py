@@ -109,12 +109,16 @@ def sobol(
     if args.json:
         out.say(json.dumps({**summary, "archive_record": kept.record}, indent=2))
         return 0
-    where = f"at {spec.at['obliquity_deg']:g} deg" if "obliquity_deg" in spec.at else ""
+    where = (
+        "at each point's obliquity"
+        if "obliquity_deg" in spec.inputs
+        else f"at {spec.at['obliquity_deg']:g} deg"
+    )
     for quantity_name, indices in found.items():
         what = (
             f"perforation, {indices.evaluations:,} runs"
             if quantity_name == "perforation"
-            else f"the ballistic limit {where}, {indices.evaluations:,} limits".replace("  ", " ")
+            else f"the ballistic limit {where}, {indices.evaluations:,} limits"
         )
         out.say(f"{spec.source}: Sobol' indices of {what}")
         for input_name, index in summary[quantity_name]["indices"].items():

@@ -75,12 +75,12 @@ def small_print(fig: Figure, text: str, width: float) -> None:
 
 
 def panel_grid(
-    count: int, panel_width: float, row_height: float, foot: float
+    count: int, panel_width: float, row_height: float, foot: float, columns: int = MAX_COLUMNS
 ) -> tuple[Figure, np.ndarray]:
-    """A figure of ``count`` panels in rows of at most :data:`MAX_COLUMNS`, each
+    """A figure of ``count`` panels in rows of at most ``columns``, each
     ``panel_width`` wide (the figure at most the page) and ``row_height`` high, with
     ``foot`` [in] for a key and titles; its axes, flat."""
-    nrows = math.ceil(count / MAX_COLUMNS)
+    nrows = math.ceil(count / columns)
     ncols = math.ceil(count / nrows)
     fig = Figure(figsize=(min(PAGE_WIDTH, panel_width * ncols), row_height * nrows + foot),
                  layout="constrained")  # fmt: skip

@@ -66,16 +66,19 @@ def _draw(ax: Axes, found: SampledLimits, shots: ShotGroup | None, confidence: f
     if np.any(found.ricochet > low):  # some sample ricochets in the speeds drawn
         _curve(ax, speeds, found.ricochet_curve(speeds, confidence), RICOCHET_COLOUR,
                f"model P(ricochet | V), {level} band", "--")  # fmt: skip
-    marks = []
+    marks = {}
     for key, level_p in LEVELS.items():
         at = found.quantile(level_p, confidence)["speed_m_s"]
         if low <= at <= high:
             ax.axvline(at, color=PERFORATION_COLOUR, lw=0.6, ls=":")
             ax.text(at, 1.09, key.upper(), fontsize=SMALL - 1, ha="center", va="bottom",
                     color=PERFORATION_COLOUR)  # fmt: skip
-            marks.append(f"{key.upper()} {at:.4g}")
-    degrees = math.degrees(found.obliquity)
-    title = f"{degrees:.4g} deg: model " + (", ".join(marks) + " m/s" if marks else "no V50 here")
+        side = f"below {found.speeds[0]:g}" if at < 0 else f"beyond {found.speeds[1]:g}"
+        marks[key] = f"{at:.4g}" if math.isfinite(at) else side
+    title = (
+        f"{math.degrees(found.obliquity):.4g} deg\nmodel V50 {marks['v50']} m/s "
+        f"(V10 {marks['v10']}, V90 {marks['v90']})"
+    )
     if shots is not None:
         if isinstance(shots.fit, V50Fit):
             draw_fit(ax, shots.fit, low, high, SHOTS_FIT_COLOUR, "shots' ")
@@ -85,7 +88,7 @@ def _draw(ax: Axes, found: SampledLimits, shots: ShotGroup | None, confidence: f
         draw_shots(ax, shots.speed, shots.perforated, shots.weight, np.random.default_rng(0))
     ax.set_xlim(low, high)
     ax.set_ylim(-0.08, 1.16)
-    ax.set_title(title, fontsize=FONT)
+    ax.set_title(title, fontsize=SMALL)
     ax.set_xlabel("impact speed [m/s]", fontsize=FONT)
     ax.set_ylabel("probability", fontsize=FONT)
     ax.tick_params(labelsize=SMALL)
@@ -104,7 +107,7 @@ def plot_velocity_response(
     V10/V50/V90 marked; ``shots[k]``: the shots at obliquity ``k`` of ``found`` and their
     fit, drawn on the same axes; ``provenance`` in small print at the foot."""
     shots = shots or {}
-    fig, axes = panel_grid(len(found), PAGE_WIDTH, 2.7, 0.9)  # the page, one panel or more
+    fig, axes = panel_grid(len(found), PAGE_WIDTH, 2.7, 0.9, columns=3)  # the page
     for k, (ax, one) in enumerate(zip(axes, found, strict=False)):
         _draw(ax, one, shots.get(k), confidence)
     shared_key(fig, axes, len(found))
