@@ -339,6 +339,7 @@ def test_the_command_prints_sobol_indices_and_draws_their_bars(tmp_path, capsys)
         (["--sobol", "100"], "--sobol: a power of 2"),
         (["--png", "x.png"], "--png draws the limits' curves, the Sobol' indices or the"),
         (["--sobol", "64", "--limits"], "--sobol: not with --limits"),
+        (["--sobol", "64", "--samples", "100"], "--samples: not with --sobol"),
         (["--sobol-of", "both"], "--sobol-of says what --sobol N analyses"),
         (["--sobol", "64", "--sobol-of", "ballistic_limit"], "inputs.speed_m_s without a"),
     ],

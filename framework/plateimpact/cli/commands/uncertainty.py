@@ -107,6 +107,11 @@ def _check_flags(args: argparse.Namespace) -> None:
         given = [flag for flag, on in others.items() if on]
         if given:
             raise UsageError(f"--sobol: not with {', '.join(given)} (one result at a time)")
+        for flag, value in (("--samples", args.samples), ("--method", args.method)):
+            if value is not None:
+                raise UsageError(
+                    f"{flag}: not with --sobol, whose points are Saltelli's, N x (inputs + 2)"
+                )
     elif args.sobol_of is not None:
         raise UsageError("--sobol-of says what --sobol N analyses: give --sobol N too")
     if args.shots is not None and not args.limits:
