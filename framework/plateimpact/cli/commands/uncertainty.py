@@ -25,7 +25,9 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
         "Sample the inputs that SPEC.json gives distributions (impact speed and obliquity, "
         "sphere radius and mass, plate thickness and constants, in their user units), run "
         "one scene per sample, and print the probability of ricochet, embedment and "
-        "perforation with exact 95% binomial intervals, and exit quantiles."
+        "perforation with exact 95% binomial intervals, and exit quantiles; or the sampled "
+        "limits (--limits), Sobol' indices (--sobol), or probability curves and maps "
+        "(--speeds, --obliquities)."
     )
     p.add_argument("spec", metavar="SPEC.json", help="the study (docs/uncertainty.md)")
     p.add_argument(
