@@ -29,12 +29,15 @@ from plateimpact.model.impact import REST_SPEED_FRACTION
 from plateimpact.storage import append as appending
 from plateimpact.uncertainty import propagate, read_spec
 from plateimpact.uncertainty.archived import (
+    KIND_LIMITS,
     indices_to_record,
     limits_to_record,
     map_to_record,
     read_stored,
+    record_name,
 )
 from plateimpact.uncertainty.curves import outcome_grid
+from plateimpact.uncertainty.kept import SEARCH, kept_limits
 from plateimpact.uncertainty.limits import sampled_limits, sampled_limits_at
 from plateimpact.uncertainty.sensitivity import ballistic_limit_indices, perforation_indices
 from plateimpact.uncertainty.spec import UncertaintySpecError
@@ -263,6 +266,24 @@ def test_each_kind_of_record_reads_back_as_computed(registry, at_30, tmp_path):
     other = read_spec(oblique(60, seed=7), registry)
     with pytest.raises(pi.ArchiveError, match="made for another spec"):
         read_stored(archive, "l", other, registry)
+
+
+def test_a_result_made_by_other_code_is_neither_kept_nor_replaced(registry, at_30, tmp_path):
+    """resume reads back only what the code that would run now made; a record of other
+    code is refused in one line, and the archive keeps it."""
+    simulation = pi.Simulation.from_names(failure="plugging", registry=registry)
+    settings = {"obliquities_deg": [30.0], **SEARCH}
+    record = limits_to_record([at_30], simulation, settings)
+    plugins = json.loads(str(record.attributes["plugins"]))
+    plugins["failure"]["source_sha256"] = "0" * 64  # as if the plug-in had changed
+    record.attributes["plugins"] = json.dumps(plugins)
+    archive = pi.Archive(tmp_path / "u.h5")
+    name = record_name(at_30.spec, KIND_LIMITS, settings)
+    archive.append_record(name, record)
+    index = archive.path.read_bytes()
+    with pytest.raises(pi.ArchiveError, match="made by other code.*another archive"):
+        kept_limits(at_30.spec, registry, [30.0], archive, resume=True)
+    assert archive.path.read_bytes() == index
 
 
 class Counted:

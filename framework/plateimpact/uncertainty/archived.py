@@ -30,7 +30,7 @@ from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
 from ..storage.records import LIMITS, Record, RecordColumn
-from ..study.reruns import check_code
+from ..study.reruns import StaleRunError, check_code
 from .curves import OutcomeGrid
 from .inputs import input_table
 from .limits import SampledLimits
@@ -335,7 +335,10 @@ def kept_or_computed(
                 f"{name}): read it back with resume (--resume), or use another archive"
             )
         record = archive.record(name)
-        check_code(what, record.attributes.get("plugins"), code)
+        try:
+            check_code(what, record.attributes.get("plugins"), code)
+        except StaleRunError as exc:  # a stored result is never replaced
+            raise RecordExistsError(f"{exc.what}; store into another archive") from None
         return _read_back(record, what, spec, from_record)
     found = compute()
     archive.append_record(name, to_record(found))
