@@ -29,6 +29,7 @@ from plateimpact.uncertainty import (
 from plateimpact.uncertainty.curves import outcome_grid
 from plateimpact.uncertainty.limits import sampled_limits
 from plateimpact.uncertainty.propagation import (
+    binomial_intervals,
     sample_inputs,
     scenes,
     study_name,
@@ -90,6 +91,17 @@ def test_stratified_points_fill_every_stratum_once(method):
     points = unit_samples(method, n, 3, seed=11)
     for column in points.T:
         assert np.array_equal(np.sort(np.floor(column * n)), np.arange(n))
+
+
+@pytest.mark.parametrize("n", [2, 7, 60, 2000, 100_000])
+def test_binomial_intervals_are_scipys_exact_ones(n):
+    """The Clopper–Pearson interval from beta quantiles, all counts at once, is the one
+    scipy.stats.binomtest finds by root-finding, count by count."""
+    counts = np.unique(np.linspace(0, n, min(n + 1, 60)).astype(int))
+    low, high = binomial_intervals(counts, n, 0.95)
+    for k, lo, hi in zip(counts, low, high, strict=True):
+        ci = stats.binomtest(int(k), n).proportion_ci(0.95, method="exact")
+        assert lo == pytest.approx(ci.low, abs=1e-11) and hi == pytest.approx(ci.high, abs=1e-11)
 
 
 def test_independent_draws_pass_a_uniformity_test():
