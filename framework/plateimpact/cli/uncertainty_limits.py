@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from typing import Any
 
 import attrs
@@ -24,7 +23,7 @@ from ..uncertainty.limits import OUTSIDE
 from ..uncertainty.spec import UncertaintySpec, UncertaintySpecError
 from ..v50 import V50Fit, fit_v50
 from .common import UsageError, save_figure_atomically
-from .formatting import interval, number, shown
+from .formatting import interval, number, shown, user
 from .limit_options import values
 from .uncertainty_modes import (
     archive_of,
@@ -87,7 +86,7 @@ def _shots(
             )
     found = {}
     for obliquity, group in shots.groups_by_obliquity().items():
-        degrees = float(f"{math.degrees(obliquity):.12g}")
+        degrees = user(IMPACT_OBLIQUITY, obliquity)
         at = np.flatnonzero(np.isclose(angles, degrees, rtol=1e-9, atol=1e-9))
         if at.size == 0:
             listed = ", ".join(f"{a:g}" for a in angles)
