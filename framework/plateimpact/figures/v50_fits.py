@@ -110,11 +110,17 @@ def _draw(ax: Axes, panel: Panel, rng: np.random.Generator) -> None:
                    label="model's ballistic limit")  # fmt: skip
         title += f"\nmodel's ballistic limit {panel.model_ballistic_limit:.4g} m/s"
     draw_shots(ax, panel.speed, panel.perforated, panel.weight, rng)
-    ax.set_xlim(low, high)
-    ax.set_ylim(-0.08, 1.08)
+    probability_axes(ax, (low, high), 1.08, "P(perforation)")
     ax.set_title(title, fontsize=FONT)
+
+
+def probability_axes(ax: Axes, speeds: tuple[float, float], top: float, label: str) -> None:
+    """A probability against impact speed [m/s] over ``speeds``: from a little below 0 to
+    ``top`` (room above 1 for the shots and marks), labelled ``label``."""
+    ax.set_xlim(*speeds)
+    ax.set_ylim(-0.08, top)
     ax.set_xlabel("impact speed [m/s]", fontsize=FONT)
-    ax.set_ylabel("P(perforation)", fontsize=FONT)
+    ax.set_ylabel(label, fontsize=FONT)
     ax.tick_params(labelsize=SMALL)
 
 

@@ -18,7 +18,7 @@ from ..limits.regimes import REGIMES
 from ..uncertainty.limits import LEVELS, SampledLimits
 from ..v50.fit import V50Fit
 from .style import FONT, PAGE_WIDTH, REGIME_COLOURS, SMALL, panel_grid, shared_key, small_print
-from .v50_fits import draw_fit, draw_shots
+from .v50_fits import draw_fit, draw_shots, probability_axes
 
 #: Speeds at which a curve is evaluated (a step function: as many as a panel has pixels).
 CURVE_POINTS = 600
@@ -86,12 +86,8 @@ def _draw(ax: Axes, found: SampledLimits, shots: ShotGroup | None, confidence: f
         else:
             title += "\nshots: no V50 fit"
         draw_shots(ax, shots.speed, shots.perforated, shots.weight, np.random.default_rng(0))
-    ax.set_xlim(low, high)
-    ax.set_ylim(-0.08, 1.16)
+    probability_axes(ax, (low, high), 1.16, "probability")
     ax.set_title(title, fontsize=SMALL)
-    ax.set_xlabel("impact speed [m/s]", fontsize=FONT)
-    ax.set_ylabel("probability", fontsize=FONT)
-    ax.tick_params(labelsize=SMALL)
 
 
 def plot_velocity_response(
