@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import math
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -25,6 +26,8 @@ from test_progress import Pipe, Terminal, ticking
 import plateimpact as pi
 from plateimpact import presets
 from plateimpact.cli import main
+from plateimpact.limits.lines import SPEED, Boundary, LimitLine
+from plateimpact.limits.regimes import Regime
 from plateimpact.model.impact import REST_SPEED_FRACTION
 from plateimpact.storage import append as appending
 from plateimpact.uncertainty import propagate, read_spec
@@ -38,6 +41,7 @@ from plateimpact.uncertainty.archived import (
 )
 from plateimpact.uncertainty.curves import outcome_grid
 from plateimpact.uncertainty.kept import SEARCH, kept_limits
+from plateimpact.uncertainty.limit_search import named_limits
 from plateimpact.uncertainty.limits import sampled_limits, sampled_limits_at
 from plateimpact.uncertainty.sensitivity import ballistic_limit_indices, perforation_indices
 from plateimpact.uncertainty.spec import UncertaintySpecError
@@ -106,6 +110,40 @@ def test_the_ricochet_limit_lies_below_the_ballistic_limit_and_both_are_found(at
     assert np.all(at_30.ricochet < at_30.ballistic)
     report = at_30.report("ricochet")
     assert report["within_range"] == 60 and report["v10_m_s"] < report["v90_m_s"]
+
+
+def line(*bands: tuple[pi.Outcome, bool, float]) -> LimitLine:
+    """A line along speed over 50-2000 m/s whose regimes change at the given speeds
+    (each band: outcome, plate failed, where it ends), brackets 0.1 m/s wide."""
+    regimes = [Regime(o, failed) for o, failed, _ in bands]
+    boundaries = tuple(
+        Boundary(end - 0.05, end + 0.05, below, above)
+        for (_, _, end), below, above in zip(bands[:-1], regimes[:-1], regimes[1:], strict=True)
+    )
+    return LimitLine(SPEED, 0.5, 50.0, 2000.0, boundaries, regimes[0])
+
+
+R, E, P = pi.Outcome.RICOCHET, pi.Outcome.EMBEDMENT, pi.Outcome.PERFORATION
+
+
+@pytest.mark.parametrize(
+    "bands, expected",
+    [
+        (((R, False, 300), (E, True, 400), (P, True, 2000)), (400, 300, False, False)),
+        (((E, False, 400), (P, True, 2000)), (400, -math.inf, False, False)),
+        (((R, False, 2000),), (math.inf, math.inf, False, False)),
+        (((P, True, 2000),), (-math.inf, -math.inf, False, False)),
+        (((E, False, 100), (R, False, 300), (E, False, 400), (P, True, 2000)),
+         (400, 300, False, True)),  # a ricochet band above an embedment one
+        (((R, False, 200), (P, True, 300), (E, True, 500), (P, True, 2000)),
+         (500, 200, True, False)),  # a perforation band below an embedment one
+    ],
+)  # fmt: skip
+def test_each_lines_limits_are_those_plateimpact_limits_names(bands, expected):
+    """Ballistic and ricochet limits as LimitLine names them (docs/limits.md), ±inf for
+    none in the range on the side the curve needs, and the gaps the curve would miss."""
+    found = named_limits(line(*bands))
+    assert found[:2] == pytest.approx(expected[:2], abs=0.05) and found[2:] == expected[2:]
 
 
 def test_limits_at_several_obliquities_are_each_obliquitys_alone(registry, at_30):

@@ -71,7 +71,7 @@ def sample_scenes(
     return scenes(nominal, values, registry)
 
 
-def _named(line: LimitLine) -> tuple[float, float, bool, bool]:
+def named_limits(line: LimitLine) -> tuple[float, float, bool, bool]:
     """(ballistic limit, ricochet limit, perforation gap, ricochet gap) of one line."""
     outcomes = [band.regime.outcome for band in line.bands]
     ballistic = line.ballistic_limit
@@ -121,7 +121,10 @@ def line_limits(
     n = sample_of_line.size
     found = locate(evaluate, np.full(n, speeds[0]), np.full(n, speeds[1]), resolution, tolerance)
     named = np.array(
-        [_named(line_of(found, i, SPEED, float(obliquity_of_line[i]), speeds)) for i in range(n)],
+        [
+            named_limits(line_of(found, i, SPEED, float(obliquity_of_line[i]), speeds))
+            for i in range(n)
+        ],
         dtype=float,
     ).reshape(n, 4)
     return LineLimits(
