@@ -5,6 +5,7 @@ the model's ballistic limit beside it; the MIL-STD-662F estimate; one line and e
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -260,3 +261,29 @@ def test_the_models_limit_scan_bound_names_the_flag_v50_has(shots_csv, capsys, m
     assert main([*args, "--force", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert all(row["model_ballistic_limit_m_s"] is not None for row in out)
+
+
+def test_the_figure_names_the_file_not_its_path_and_keys_the_v50_line(
+    shots_csv, tmp_path, monkeypatch
+):
+    from plateimpact.figures import v50_fits
+
+    drawn_figures = []
+
+    def keeping(*args, **kwargs):
+        figure = original(*args, **kwargs)
+        drawn_figures.append(figure)
+        return figure
+
+    original = v50_fits.v50_figure
+    monkeypatch.setattr(v50_fits, "v50_figure", keeping)
+    elsewhere = tmp_path / "deep" / "er"
+    elsewhere.mkdir(parents=True)
+    monkeypatch.chdir(elsewhere)  # the shots given by a path with ../ in it
+    given = os.path.relpath(shots_csv, elsewhere)
+    assert main(["v50", given, "--by-obliquity", "--bootstrap", "0", "--png", "f.png"]) == 0
+    (figure,) = drawn_figures
+    heading = figure._suptitle.get_text()
+    assert heading.startswith(f"{shots_csv.name}: ") and ".." not in heading
+    keyed = {text.get_text() for legend in figure.legends for text in legend.get_texts()}
+    assert "V50" in keyed  # the dotted line at the V50, beside the fit and its interval

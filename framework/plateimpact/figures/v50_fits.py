@@ -63,7 +63,7 @@ def draw_fit(
     speeds = np.linspace(low, high, CURVE_POINTS)
     ax.plot(speeds, estimate.probability(speeds), color=colour, lw=1.2,
             label=f"{what}{estimate.method} fit")  # fmt: skip
-    ax.axvline(estimate.v50_m_s, color=colour, lw=0.6, ls=":")
+    ax.axvline(estimate.v50_m_s, color=colour, lw=0.6, ls=":", label=f"{what}V50")
 
 
 def draw_shots(

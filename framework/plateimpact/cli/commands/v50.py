@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -238,7 +239,8 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
                   groups[o].perforated, groups[o].weight, r, model_limits.get(o))
             for o, r in results.items()
         ]  # fmt: skip
-        figure = v50_figure(panels, title=args.shots, model=model)
+        # the file's name, not the path it was given by (relative to somewhere else)
+        figure = v50_figure(panels, title=Path(args.shots).name, model=model)
         save_figure_atomically(figure, args.png, dpi=args.dpi)
     rows = [_json(args, o, r, groups[o].labels, model_limits, model) for o, r in results.items()]
     if args.json:
