@@ -101,10 +101,36 @@ def test_the_family_key_and_the_outcome_maps_share_one_palette(eight_obliquities
         pi.Simulation.from_names(), pi.presets.DEFAULT_SPHERE,
         pi.presets.plate("2024-T3/3.18"), np.radians([0.0, 60.0]), resolution=40.0,
     )  # fmt: skip
-    bands = key_colours(plot_bands(found, "x").axes[0].get_legend())
+    bands = key_colours(plot_bands(found, "x").legends[0])
     common = set(family) & set(bands)
     assert {"ricochet", "embedment", "perforation"} <= common
     assert all(family[label] == bands[label] for label in common)
+
+
+def test_the_bands_key_names_each_limit_mark_and_sits_clear_of_the_axis_label():
+    from plateimpact.figures.limits_and_maps import plot_bands  # noqa: PLC0415
+
+    found = pi.limits.along_speed(
+        pi.Simulation.from_names(), pi.presets.DEFAULT_SPHERE,
+        pi.presets.plate("2024-T3/3.18"), np.radians([30.0, 60.0]), resolution=40.0,
+    )  # fmt: skip
+    assert all(line.ricochet_limit is not None for line in found.lines)
+    fig = plot_bands(found, "x")
+    (key,) = fig.legends
+    labels = [text.get_text() for text in key.get_texts()]
+    assert "ballistic limit" in labels and "ricochet limit" in labels
+    marks = {line.get_linestyle() for line in fig.axes[0].get_lines()}
+    assert len(marks) == 2  # the two limits drawn differently, both keyed
+    assert all(colour != "w" for line in fig.axes[0].get_lines()
+               for colour in [line.get_color()])  # fmt: skip
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: PLC0415
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    label_box = fig.axes[0].xaxis.label.get_window_extent(renderer)
+    key_box = key.get_window_extent(renderer)
+    assert key_box.y1 <= label_box.y0  # below the x label, not over it
 
 
 def test_no_line_joins_two_outcomes_and_embedments_are_not_lines(eight_obliquities):

@@ -40,13 +40,27 @@ def _model_line(model: dict[str, object]) -> str:
     return f"{model.get('resistance')} + {model.get('failure')}, {model.get('integrator')}"
 
 
+#: How each limit is marked on the bars: solid black for the ballistic limit (or the
+#: critical ricochet obliquity), dotted near-black for the ricochet limit. Both dark, so
+#: that they show on every regime's colour and on paper; their key says which is which.
+_LIMIT_MARKS: dict[str, dict[str, Any]] = {
+    "ballistic limit": {"color": "k", "lw": 2.0, "ls": "-"},
+    "ricochet limit": {"color": "0.1", "lw": 2.0, "ls": (0, (1, 1))},
+    "critical ricochet obliquity": {"color": "k", "lw": 2.0, "ls": "-"},
+}
+
+
 def plot_bands(found: Limits, label: str) -> Figure:
-    """One bar per line, coloured by band; limits marked (black: ballistic limit or
-    critical ricochet obliquity, white: ricochet limit)."""
-    fig, ax = figure(figsize=(8.0, 0.9 + 0.38 * len(found.lines)), layout="constrained")
+    """One bar per line, coloured by band, at journal width; the limits marked (solid:
+    ballistic limit or critical ricochet obliquity, dotted: ricochet limit), with one
+    key below the axes for the regimes and the marks."""
+    from matplotlib.lines import Line2D  # noqa: PLC0415
+
+    fig, ax = figure(figsize=(PAGE_WIDTH, 1.3 + 0.3 * len(found.lines)), layout="constrained")
     along_speed = found.axis != OBLIQUITY
     scale = 1.0 if along_speed else _DEG
     seen: set[Regime] = set()
+    marked: set[str] = set()
     for k, line in enumerate(found.lines):
         for band in line.bands:
             seen.add(band.regime)
@@ -54,12 +68,13 @@ def plot_bands(found: Limits, label: str) -> Figure:
                 [(band.start / scale, band.width / scale)], (k - 0.4, 0.8),
                 facecolors=regime_colour(band.regime),
             )  # fmt: skip
-        marks = [(line.ballistic_limit, "k"), (line.ricochet_limit, "w")]
+        marks = [("ballistic limit", line.ballistic_limit), ("ricochet limit", line.ricochet_limit)]
         if not along_speed:
-            marks = [(line.critical_ricochet_obliquity, "k")]
-        for at, colour in marks:
+            marks = [("critical ricochet obliquity", line.critical_ricochet_obliquity)]
+        for name, at in marks:
             if at is not None:
-                ax.plot([at / scale] * 2, [k - 0.45, k + 0.45], color=colour, lw=2)
+                marked.add(name)
+                ax.plot([at / scale] * 2, [k - 0.45, k + 0.45], **_LIMIT_MARKS[name])
     ax.set_yticks(range(len(found.lines)))
     ax.set_yticklabels(
         [
@@ -67,15 +82,18 @@ def plot_bands(found: Limits, label: str) -> Figure:
             for line in found.lines
         ]
     )
-    ax.set_ylabel("impact obliquity" if along_speed else "impact speed")
-    ax.set_xlabel("impact speed [m/s]" if along_speed else "impact obliquity [deg]")
+    ax.tick_params(labelsize=SMALL)
+    ax.set_ylabel("impact obliquity" if along_speed else "impact speed [m/s]", fontsize=FONT)
+    ax.set_xlabel("impact speed [m/s]" if along_speed else "impact obliquity [deg]",
+                  fontsize=FONT)  # fmt: skip
     ax.set_xlim(found.lines[0].start / scale, found.lines[0].end / scale)
     ax.set_ylim(-0.6, len(found.lines) - 0.4)
-    limits = "black: ballistic limit, white: ricochet limit" if along_speed else (
-        "black: critical ricochet obliquity"
-    )  # fmt: skip
-    ax.set_title(f"{label}: outcome bands ({_model_line(found.model)}); {limits}", fontsize=9)
-    _key(ax, sorted(seen), loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=5)
+    ax.set_title(f"{label}: outcome bands ({_model_line(found.model)})", fontsize=FONT)
+    handles: list[Any] = list(regime_key(sorted(seen)))
+    handles += [Line2D([], [], label=name, **_LIMIT_MARKS[name])
+                for name in _LIMIT_MARKS if name in marked]  # fmt: skip
+    fig.legend(handles=handles, loc="outside lower center", ncol=4, fontsize=SMALL,
+               frameon=False)  # fmt: skip
     return fig
 
 
