@@ -374,3 +374,17 @@ def test_bad_input_is_one_line(readme_archive, tmp_path):
         code, out, err = run_cli(argv)
         assert_one_line(code, err, *words)
         assert out == ""
+
+
+def test_the_figure_draws_no_line_across_an_outcome_change_and_no_embedment():
+    from plateimpact.figures.compared_runs import plot_comparison
+
+    fig = plot_comparison(hand_made().compare("a", "b"))
+    (column,) = [ax for ax in fig.axes if ax.get_title() == "2024-T3/3.18, 30°"]
+    drawn = {"-": set(), "--": set()}
+    for line in column.get_lines():
+        drawn[line.get_linestyle()].add(tuple(line.get_xdata()))
+    # From ROW_30 by hand: a is P P R R E Ef P P R P and b is E E R R R Ef R R E E at
+    # 100 ... 1000 m/s; each stretch of one regime a line (one scene: a dot), embedments none.
+    assert drawn["-"] == {(100, 200), (300, 400), (700, 800), (900,), (1000,)}
+    assert drawn["--"] == {(300, 400, 500), (700, 800)}

@@ -1,4 +1,7 @@
-"""The two runs of a :class:`~.ranges.Comparison` overlaid, outcome changes shaded."""
+"""The two runs of a :class:`~.ranges.Comparison` overlaid, outcome changes shaded: drawn
+as the study figures draw runs (:func:`~.exit_curves.plot_exit_curves`: one line per
+stretch of one regime, none across an outcome change, embedments not drawn), at
+journal width."""
 
 from __future__ import annotations
 
@@ -9,8 +12,8 @@ from matplotlib.patches import Patch
 
 from ..comparison.ranges import Comparison, ComparisonRow
 from ..limits.lines import SPEED
-from ..model.results import Outcome
-from .style import figure
+from .exit_curves import plot_exit_curves
+from .style import FONT, PAGE_WIDTH, RUN_STYLES, SMALL, figure
 
 #: Shades of the ranges whose outcome differs, one per change (A's regime -> B's).
 CHANGE_SHADES = ("#f6d2cc", "#d5e5f5", "#f7e6c4", "#e4d9f0", "#d6eedb", "#e8e8e8")
@@ -41,20 +44,22 @@ def _draw_row(
         for ax in axes:
             shade = shades[change.pair]
             ax.axvspan(edges[first], edges[last + 1], color=shade, lw=0, zorder=0)
-    marker = "o" if x.size < 3 else None
+    order = np.argsort(x, kind="stable")
     for result, style in (
-        (comparison.result_a, {"color": "C0", "ls": "-"}),
-        (comparison.result_b, {"color": "C1", "ls": "--"}),
+        (comparison.result_a, RUN_STYLES[0]),
+        (comparison.result_b, RUN_STYLES[1]),
     ):
-        part = result.take(row.index)
-        leaves = part.outcome != Outcome.EMBEDMENT  # an embedment has no exit direction
-        axes[0].plot(x, part.exit_speed, marker=marker, **style)
-        obliquity = np.where(leaves, np.degrees(part.exit_obliquity), np.nan)
-        axes[1].plot(x, obliquity, marker=marker, **style)
+        plot_exit_curves(list(axes), x[order], result.take(row.index[order]), **style)
+    if not axes[1].lines:  # every sphere of both runs embedded: say so, not an empty panel
+        axes[1].text(0.5, 0.5, "no exit: embedded in both runs", transform=axes[1].transAxes,
+                     ha="center", va="center", fontsize=SMALL, color="0.35")  # fmt: skip
     fixed = f"{np.degrees(row.fixed):g}°" if row.axis == SPEED else f"{row.fixed:g} m/s"
-    axes[0].set_title(f"{row.plate}, {fixed}", fontsize=9)
-    axes[1].set_xlabel("impact speed [m/s]" if row.axis == SPEED else "impact obliquity [deg]")
-    axes[1].set_ylim(0, 185)
+    axes[0].set_title(f"{row.plate}, {fixed}", fontsize=FONT)
+    axes[1].set_xlabel("impact speed [m/s]" if row.axis == SPEED else "impact obliquity [deg]",
+                       fontsize=FONT)  # fmt: skip
+    axes[1].set_ylim(-5, 185)  # an exit along the normal (0 deg) off the frame's edge
+    for ax in axes:
+        ax.tick_params(labelsize=SMALL)
     if x.size > 1:
         axes[1].set_xlim(x[0], x[-1])
 
@@ -62,27 +67,29 @@ def _draw_row(
 def plot_comparison(comparison: Comparison) -> Figure:
     """Exit speed and exit obliquity of run A (solid) and run B (dashed) along every row
     of the comparison (a column each), the ranges whose outcome differs shaded, one shade
-    per change; exit obliquities only where the sphere leaves the plate."""
+    per change; exit speeds and obliquities only where the sphere leaves the plate."""
     rows = comparison.rows()
     pairs = dict.fromkeys(change.pair for row in rows for change in row.ranges)
     shades = {pair: CHANGE_SHADES[k % len(CHANGE_SHADES)] for k, pair in enumerate(pairs)}
     fig, axes = figure(
         2,
         len(rows),
-        figsize=(3.2 * len(rows), 6),
+        figsize=(PAGE_WIDTH, 4.2),
         sharex="col",
         squeeze=False,
         layout="constrained",
     )
     for column, row in enumerate(rows):
         _draw_row(axes[:, column], comparison, row, shades)
-    axes[0, 0].set_ylabel("exit speed [m/s]")
-    axes[1, 0].set_ylabel("exit obliquity [deg]")
+    axes[0, 0].set_ylabel("exit speed [m/s]", fontsize=FONT)
+    axes[1, 0].set_ylabel("exit obliquity [deg]", fontsize=FONT)
     legend = [
-        Line2D([], [], color="C0", ls="-", label=comparison.run_a),
-        Line2D([], [], color="C1", ls="--", label=comparison.run_b),
+        Line2D([], [], label=comparison.run_a, **RUN_STYLES[0]),
+        Line2D([], [], label=comparison.run_b, **RUN_STYLES[1]),
         *(Patch(color=shade, label=pair) for pair, shade in shades.items()),
     ]
-    fig.legend(handles=legend, loc="outside lower center", ncols=min(len(legend), 4), fontsize=8)
-    fig.suptitle(f"{comparison.run_b} (dashed) against {comparison.run_a} (solid)")
+    fig.legend(handles=legend, loc="outside lower center", ncols=min(len(legend), 3),
+               fontsize=SMALL, frameon=False)  # fmt: skip
+    fig.suptitle(f"{comparison.run_b} (dashed) against {comparison.run_a} (solid)",
+                 fontsize=FONT)  # fmt: skip
     return fig
