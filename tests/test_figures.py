@@ -309,3 +309,37 @@ def test_panels_with_no_exit_or_one_speed_are_drawn_and_say_so():
     speed_ax, _, strip = exit_curves.plot_study(one).axes
     (dot,) = curve_lines(speed_ax)
     assert dot.get_marker() == "." and list(dot.get_xdata()) == [900.0]
+
+
+def test_a_crater_figure_keys_its_floor_the_centres_path_and_the_spheres():
+    from plateimpact.figures.crater_sections import plot_crater  # noqa: PLC0415
+    from plateimpact.model.crater import crater_section  # noqa: PLC0415
+
+    sphere, plate = pi.presets.DEFAULT_SPHERE, pi.presets.plate("2024-T3/3.18")
+    result = pi.Simulation.from_names().run(
+        pi.Scene(sphere, plate, 500.0, math.radians(45.0)), record_trajectory=True
+    )
+    section = crater_section(result.trajectory, sphere.radius, thickness=plate.thickness)
+    fig, ax = style.figure()
+    plot_crater(ax, section, trajectory=result.trajectory, radius=sphere.radius)
+    labels = [text.get_text() for text in ax.legend().get_texts()]
+    assert labels == ["crater floor", "front surface", "path of the centre",
+                      "sphere at first contact, deepest, last"]  # fmt: skip
+    circles = [line for line in ax.get_lines() if line.get_label() == "_nolegend_"]
+    assert len(circles) == 2  # the three spheres keyed once
+
+
+def test_the_study_paths_have_no_colour_too_pale_for_white_paper(tmp_path):
+    from plateimpact.figures.study_paths import plot_study_paths  # noqa: PLC0415
+
+    study = pi.Study.grid("p", ["2024-T3/3.18"], [60.0], np.linspace(150.0, 1000.0, 6),
+                          pi.Variant("v"))  # fmt: skip
+    fig = plot_study_paths(study.run(record_trajectory=True), kind="trajectory")
+    (ax,) = fig.axes
+    for line in ax.get_lines():  # WCAG 2's contrast of graphics with white: at least 3:1
+        linear = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+                  for c in to_rgba(line.get_color())[:3]]  # fmt: skip
+        luminance = 0.2126 * linear[0] + 0.7152 * linear[1] + 0.0722 * linear[2]
+        assert 1.05 / (luminance + 0.05) >= 3.0, line.get_label()
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert labels[-2:] == ["front surface", "back surface"]

@@ -62,7 +62,9 @@ def plot_study_paths(
     )  # fmt: skip
     for ax, (label, ob, index) in zip(axes[:, 0], panels, strict=True):
         chosen = index[_pick(study.scenes.impact_speed[index], speeds, count)]
-        colours = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, chosen.size))
+        # viridis short of its pale end: every line keeps a 3:1 contrast with white paper
+        # (WCAG's threshold for graphics), which the yellow-green beyond 0.6 does not
+        colours = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.6, chosen.size))
         thickness = study.scenes.thickness[chosen[0]] * 1e3
         for k, run in enumerate(runs):
             result = results[run]
@@ -78,8 +80,8 @@ def plot_study_paths(
                     assert path is not None  # checked above
                     centre = (path.penetration - study.scenes.radius[i]) * 1e3
                     ax.plot(path.lateral * 1e3, centre, label=name, **style)
-        ax.axhline(0.0, color="0.3", lw=0.8)
-        ax.axhline(thickness, color="0.3", lw=0.8, ls=":")
+        ax.axhline(0.0, color="0.3", lw=0.8, label="front surface")
+        ax.axhline(thickness, color="0.3", lw=0.8, ls=":", label="back surface")
         ax.set_title(
             f"{label}, {ob:g}° ({', '.join(short_run_name(r, study.name) for r in runs)})",
             fontsize=FONT,

@@ -50,13 +50,17 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
         outputs.append(text_output(args.csv, csv_text([lateral.key, depth.key], rows), "--csv"))
     if args.png is not None:
         from ...figures.crater_sections import plot_crater  # noqa: PLC0415 (matplotlib only when drawing)
-        from ...figures.style import figure  # noqa: PLC0415
+        from ...figures.style import FONT, PAGE_WIDTH, SMALL, figure  # noqa: PLC0415
 
-        fig, ax = figure(figsize=(8, 4))
+        fig, ax = figure(figsize=(PAGE_WIDTH, 3.2), layout="constrained")
         plot_crater(ax, section, trajectory=result.trajectory, radius=scene.sphere.radius)
         speed = number(IMPACT_SPEED, scene.impact_speed)
         obliquity = number(IMPACT_OBLIQUITY, scene.impact_obliquity)
-        ax.set_title(f"{label}, {speed} m/s at {obliquity}°: {result.outcome.label}")
+        ax.set_title(f"{label}, {speed} m/s at {obliquity}°: {result.outcome.label}", fontsize=FONT)
+        ax.tick_params(labelsize=SMALL)
+        ax.xaxis.label.set_size(FONT)
+        ax.yaxis.label.set_size(FONT)
+        ax.legend(fontsize=SMALL, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
         outputs.append(figure_output(fig, args.png, "--png", args.dpi))
     write_together(outputs)
     return 0
