@@ -201,6 +201,9 @@ def test_the_figure_has_a_panel_per_obliquity_to_the_nearest_degree():
     figure = validation_figure(report, SIMULATION, points=20)
     titles = [ax.get_title() for ax in figure.axes if ax.get_title()]
     assert titles == ["45°", "60°"] and len(figure.axes) == 6  # three axes a panel
+    model = SIMULATION.model  # the figure says which model its curves are
+    assert (f"model: {model.resistance.name} + {model.failure.name}, "
+            f"{SIMULATION.integrator.name}") in figure._suptitle.get_text()  # fmt: skip
     many = "".join(f"300,{k},1\n" for k in range(MAX_PANELS + 1))
     with pytest.raises(pi.ShotDataError, match=f"shots at {MAX_PANELS + 1} obliquities"):
         validation_figure(

@@ -111,7 +111,10 @@ def validation_figure(
     fig.legend(handles=entries, loc="outside lower center", fontsize=SMALL, frameon=False,
                ncol=math.ceil(len(entries) / 3))  # fmt: skip
     agreement = f"outcome agreement {100 * report.agreement:.1f}% over {len(shots)} shots"
-    fig.suptitle(f"{title or report.plate.material}: {agreement}", fontsize=FONT + 1)
+    drawn = simulation.model  # which model the curves and strips are (a plate, many models)
+    names = f"{drawn.resistance.name} + {drawn.failure.name}, {simulation.integrator.name}"
+    fig.suptitle(f"{title or report.plate.material}: {agreement}\nmodel: {names}",
+                 fontsize=FONT + 1)  # fmt: skip
     return fig
 
 
