@@ -135,7 +135,8 @@ def write_run_file(
             write_ragged(f, "trajectory", SAMPLE, result.trajectory, fields)
         if result.craters is not None:
             write_ragged(f, "crater", POINT, result.craters, CRATER_FIELDS)
-        seal_file(f, {"Conventions": CONVENTIONS, **attributes})
+        what = f"run {attributes.get('study')}/{attributes.get('run')}"
+        seal_file(f, {**described(what, attributes), **attributes})
 
 
 def write_scenes_file(
@@ -150,7 +151,25 @@ def write_scenes_file(
 
     with h5netcdf.File(path, "w") as f:
         write_scenes(f, columns, declared, plate_labels)
-        seal_file(f, {"Conventions": CONVENTIONS, **attributes})
+        seal_file(f, {**described(f"scenes of study {attributes.get('study')}", attributes),
+                      **attributes})  # fmt: skip
+
+
+#: The global attributes CF asks of every file (§2.6.2), besides those the archive stores.
+OWN_LABELS = ("Conventions", "title", "history")
+
+
+def described(what: str, attributes: Mapping[str, object]) -> dict[str, str]:
+    """A data file's ``Conventions``, ``title`` and ``history`` (CF §2.6.2): what it holds
+    and, for a run, when it started (a study's scenes file carries no time, so that
+    writing the same study twice gives the same file)."""
+    when = attributes.get("start_time")
+    return {
+        "Conventions": CONVENTIONS,
+        "title": f"plateimpact {what}: rigid spheres striking plates (model of NWC TP 5844)",
+        "history": f"{when + ': ' if isinstance(when, str) else ''}{what} computed and "
+        "written by plateimpact",
+    }
 
 
 def seal_file(f: Any, attributes: Mapping[str, object]) -> None:
