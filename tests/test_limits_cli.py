@@ -130,6 +130,41 @@ def test_map_draws_outcomes_and_limit_curves(tmp_path):
     assert "ballistic limit" in curves.read_text()
 
 
+def test_map_csv_and_json_give_every_cell_of_every_map_in_user_units(tmp_path):
+    small = ["--speeds", "100:1500:5", "--obliquities", "0,45", "--tolerance", "5"]
+    cells = tmp_path / "cells.csv"
+    argv = ["map", *PLATE, "--preset", "2024-T3/6.35", *small, "--csv", str(cells), "--json"]
+    code, out, err = run_cli(argv)
+    assert code == 0, err
+    maps = json.loads(out)["maps"]  # --json: the one object is all that is printed
+    assert [m["preset"] for m in maps] == ["2024-T3/3.18", "2024-T3/6.35"]
+    assert maps[0]["impact_speed_m_s"] == [100.0, 450.0, 800.0, 1150.0, 1500.0]
+    assert maps[0]["impact_obliquity_deg"] == [0.0, 45.0]
+    rows = list(csv.DictReader(io.StringIO(cells.read_text())))
+    assert list(rows[0]) == ["plate", "impact_obliquity_deg", "impact_speed_m_s", "outcome",
+                             "plate_failed", "exit_speed_m_s", "exit_obliquity_deg"]  # fmt: skip
+    assert len(rows) == 2 * 2 * 5  # plates x obliquities x speeds
+    for row in rows:  # the CSV's cells are the JSON's, cell by cell
+        one = maps[0] if row["plate"] == "2024-T3/3.18" else maps[1]
+        i = one["impact_obliquity_deg"].index(float(row["impact_obliquity_deg"]))
+        j = one["impact_speed_m_s"].index(float(row["impact_speed_m_s"]))
+        assert row["outcome"] == one["outcome"][i][j]
+        assert float(row["exit_speed_m_s"]) == one["exit_speed_m_s"][i][j]
+    # the physics at the corners: the slow normal impact stays in, the fast one goes through
+    # with the exit speed below the impact speed; the slow 45 deg impact bounces off
+    thin = maps[0]
+    assert thin["outcome"][0][0] == "embedment" and thin["outcome"][0][-1] == "perforation"
+    assert 0.0 < thin["exit_speed_m_s"][0][-1] < 1500.0
+    assert thin["outcome"][1][0] == "ricochet" and thin["exit_obliquity_deg"][1][0] > 90.0
+
+
+def test_map_without_an_output_is_one_line(tmp_path):
+    code, _, err = run_cli(["map", *PLATE])
+    assert_one_line(code, err, "--png FILE, --csv FILE or --json")
+    code, _, err = run_cli(["map", "--kind", "limits", *PLATE, "--json"])
+    assert_one_line(code, err, "--kind limits is a figure: give --png FILE")
+
+
 def test_a_map_of_degrees_round_trips_its_rows():
     found = limits.outcome_map(
         pi.Simulation.from_names(), presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18"),

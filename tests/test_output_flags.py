@@ -36,6 +36,8 @@ OUTPUT_FLAGS = [
     (["v50", str(GONOGO), "--by-obliquity", "--bootstrap", "0"], "--png", ".png"),
     (["plot", "ARCHIVE", "--run", "v"], "--out", ".png"),
     (["compare", "ARCHIVE", "v", "w"], "--png", ".svg"),
+    (["map", "--preset", "2024-T3/3.18", "--speeds", "300:900:3", "--obliquities", "0,45",
+      "--tolerance", "5"], "--csv", ".csv"),
 ]  # fmt: skip
 IDS = [f"{argv[0]} {flag}" for argv, flag, _ in OUTPUT_FLAGS]
 

@@ -5,12 +5,26 @@ from __future__ import annotations
 
 import argparse
 import copy
+import json
+import math
+from typing import Any
+
+import numpy as np
 
 from ... import limits as lim
+from ...limits.regimes import Regime
 from ...model.scene import IMPACT_OBLIQUITY
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
-from ..common import UsageError, add_dpi_option, check_directory, save_figure_atomically
+from ...storage.together import write_together
+from ..common import (
+    UsageError,
+    add_dpi_option,
+    check_directory,
+    csv_text,
+    figure_output,
+    text_output,
+)
 from ..formatting import shown
 from ..limit_options import (
     add_archive_options,
@@ -39,7 +53,10 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
         help="outcomes: the plane coloured by outcome (one panel per --preset); limits: "
         "ballistic and ricochet limits against obliquity for every --preset",
     )
-    p.add_argument("--png", metavar="FILE", required=True, help="draw here")
+    p.add_argument("--png", metavar="FILE", help="draw here")
+    p.add_argument("--csv", metavar="FILE",
+                   help="write every cell of every map as CSV (one row per cell)")  # fmt: skip
+    p.add_argument("--json", action="store_true", help="print one JSON object: every map")
     add_dpi_option(p)
     add_archive_options(p, "map_PRESET_FAILURE")
     add_body_options(p, registry, many_presets=True)
@@ -47,7 +64,12 @@ def arguments(p: argparse.ArgumentParser, registry: PluginRegistry) -> None:
 
 
 def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
+    if args.png is None and args.csv is None and not args.json:
+        raise UsageError("give --png FILE, --csv FILE or --json: what to make of the map")
+    if args.kind == "limits" and args.png is None:
+        raise UsageError("--kind limits is a figure: give --png FILE")
     check_directory(args.png, "--png", "figure")
+    check_directory(args.csv, "--csv")
     archive = writable_archive(args)
     typed(args).update({"speeds": "--speeds", "impact_speed": "--speeds",
                         "obliquities": "--obliquities", "impact_obliquity": "--obliquities",
@@ -78,15 +100,24 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
                                  extent, samples, rows, tolerance=tolerance)  # fmt: skip
     maps = [(label, one) for (_, _, label), one in zip(plates, found, strict=True)]
     shape, counted = found[0].shape, found[0].limits
-    out.say(
-        f"{', '.join(shown(label, None) for label, _ in maps)}: {len(maps)} map(s) of {shape[0]} x "
-        f"{shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
-    )
-    from ...figures.limits_and_maps import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
+    if not args.json:
+        out.say(
+            f"{', '.join(shown(label, None) for label, _ in maps)}: {len(maps)} map(s) of "
+            f"{shape[0]} x {shape[1]}, {counted.scenes:,} scenes in {counted.seconds:.1f} s"
+        )
+    outputs = []  # the cells and the figure land together
+    if args.csv is not None:
+        outputs.append(text_output(args.csv, _csv(maps), "--csv"))
+    if args.png is not None:
+        from ...figures.limits_and_maps import plot_limit_curves, plot_outcome_map  # noqa: PLC0415
 
-    draw = plot_outcome_map if args.kind == "outcomes" else plot_limit_curves
-    save_figure_atomically(draw(maps), args.png, dpi=args.dpi)
-    out.say(f"figure:  {args.png}")
+        draw = plot_limit_curves if args.kind == "limits" else plot_outcome_map
+        outputs.append(figure_output(draw(maps), args.png, "--png", args.dpi))
+    write_together(outputs)
+    if args.json:
+        out.say(json.dumps({"maps": [_json(label, one) for label, one in maps]}))
+    elif args.png is not None:
+        out.say(f"figure:  {args.png}")
     failure = simulation.model.failure.name
     for label, drawn in maps:
         name = f"map_{label}_{failure}"
@@ -94,3 +125,49 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
             name = args.name if len(maps) == 1 else f"{args.name}_{label}"
         store(archive, name, drawn, out)
     return 0
+
+
+#: A cell's columns, in user units (as ``export`` names them).
+CELL_COLUMNS = ("plate", "impact_obliquity_deg", "impact_speed_m_s", "outcome", "plate_failed",
+                "exit_speed_m_s", "exit_obliquity_deg")  # fmt: skip
+
+
+def _cells(label: str, found: lim.OutcomeMap) -> list[list[Any]]:
+    """One row per cell (obliquities outer, speeds inner); no exit obliquity (empty)
+    where the sphere stays in the plate."""
+    rows = []
+    for i, obliquity in enumerate(found.obliquities):
+        for j, speed in enumerate(found.speeds):
+            regime = Regime.of_code(int(found.regime[i, j]))
+            angle = float(found.exit_obliquity[i, j])
+            rows.append([
+                label, math.degrees(float(obliquity)), float(speed), regime.outcome.label,
+                regime.plate_failed, float(found.exit_speed[i, j]),
+                None if not math.isfinite(angle) else math.degrees(angle),
+            ])  # fmt: skip
+    return rows
+
+
+def _csv(maps: list[tuple[str, lim.OutcomeMap]]) -> str:
+    rows = [row for label, found in maps for row in _cells(label, found)]
+    return csv_text(CELL_COLUMNS, [["" if v is None else v for v in row] for row in rows])
+
+
+def _json(label: str, found: lim.OutcomeMap) -> dict[str, object]:
+    """One map: its axes, its cells row by row (obliquities) in user units, and the
+    bands along each row as ``limits --json`` gives them."""
+
+    def grid(values: np.ndarray, scale: float = 1.0) -> list[list[float | None]]:
+        return [[float(v) / scale if math.isfinite(v) else None for v in row] for row in values]
+
+    regimes = [[Regime.of_code(int(c)) for c in row] for row in found.regime]
+    return {
+        "preset": label,
+        "impact_speed_m_s": [float(v) for v in found.speeds],
+        "impact_obliquity_deg": [math.degrees(float(v)) for v in found.obliquities],
+        "outcome": [[r.outcome.label for r in row] for row in regimes],
+        "plate_failed": [[r.plate_failed for r in row] for row in regimes],
+        "exit_speed_m_s": grid(found.exit_speed),
+        "exit_obliquity_deg": grid(found.exit_obliquity, math.pi / 180.0),
+        "limits": found.limits.to_json(),
+    }
