@@ -1,5 +1,5 @@
 """``plateimpact.units``, the path the README and scripts import unit factors from
-(``from plateimpact.units import mm, deg``): the factors of :mod:`plateimpact.base.units`."""
+(``from plateimpact.units import mm, deg``): the factors of ``plateimpact.base.units``."""
 
 from __future__ import annotations
 

@@ -4,9 +4,9 @@ shows of an object (``__repr__``, ``_repr_html_``).
 
 Both come from the declarations (:class:`~plateimpact.base.parameters.Parameter`: scene
 columns, result columns, plate constants) that name the ``--json`` keys and CSV headers,
-so that a unit is written in one place (:mod:`plateimpact.base.units`): the command
+so that a unit is written in one place (``plateimpact.base.units``): the command
 line's text is formatted here too. Every piece of text a table or a repr shows goes
-through :func:`html.escape` or :func:`~plateimpact.base.untrusted.printable`, so that a
+through ``html.escape`` or :func:`~plateimpact.printable`, so that a
 label from someone else's file (a preset name, a plate's material, a plug-in's setting)
 shows as text, never as markup or a terminal's control sequence. No style sheet and no
 script: a table takes the notebook's own look.

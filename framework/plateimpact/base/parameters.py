@@ -94,7 +94,7 @@ class Parameter:
         The unit users write it in and the SI value of one such unit (``"mm"``, 1e-3).
         Default: the SI unit itself.
     default : object
-        The SI value when none is given; :data:`NO_DEFAULT` for a required quantity.
+        The SI value when none is given; ``NO_DEFAULT`` for a required quantity.
     kind : type
         ``float``, ``int``, ``bool`` or ``str`` (a setting's type; quantities are float).
     optional : bool

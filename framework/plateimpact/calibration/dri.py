@@ -48,7 +48,7 @@ class DriFit:
 
     @property
     def rms_residual(self) -> float:
-        """Root mean square of :attr:`residuals` [m/s]."""
+        """Root mean square of ``residuals`` [m/s]."""
         return float(np.sqrt(np.mean(self.residuals**2)))
 
     def __repr__(self) -> str:

@@ -3,7 +3,7 @@ standard error for its one-line errors and warnings.
 
 Every command writes through the :class:`Writer` that ``main`` hands it: text is
 flushed as it is written, so a standard output that cannot take it (a full device, a
-closed pipe end, one closed before the start) is one :class:`StdoutError` line and exit
+closed pipe end, one closed before the start) is one ``StdoutError`` line and exit
 code 2 for every command, never a traceback or Python's "Exception ignored" at exit.
 """
 
@@ -48,7 +48,7 @@ class Writer:
 
     def write(self, text: str) -> None:
         """``text`` as it is (CSV, JSON, help), flushed now: a standard output that cannot
-        take it is a one-line :class:`StdoutError` (a broken pipe stays BrokenPipeError:
+        take it is a one-line ``StdoutError`` (a broken pipe stays BrokenPipeError:
         the reader left, which is no error)."""
         if sys.stdout is None:
             raise StdoutError("standard output is closed; redirect it (e.g. > /dev/null)")

@@ -41,8 +41,8 @@ from ..run.simulation import Simulation
 from ..storage.plate_file import plate_to_dict
 from ..storage.shots import Shots
 
-#: The rows of the confusion matrix: measured outcomes, then go/no-go shots.
 PERFORATED, NOT_PERFORATED = "perforated", "not perforated"
+#: The rows of the confusion matrix: measured outcomes, then go/no-go shots.
 MEASURED = (*(o.label for o in Outcome), PERFORATED, NOT_PERFORATED)
 #: Its columns: the model's outcomes.
 PREDICTED = tuple(o.label for o in Outcome)
@@ -99,7 +99,7 @@ class ValidationReport:
     agreement : float
         Weighted fraction of shots that agree, in [0, 1].
     confusion : dict
-        measured (:data:`MEASURED`) -> predicted (:data:`PREDICTED`) -> number of shots.
+        measured (``MEASURED``) -> predicted (``PREDICTED``) -> number of shots.
     residual_speed_error, exit_obliquity_error : numpy.ndarray
         Model minus measured [m/s], [rad], NaN where the shot has no pair.
     residual_speed_rms, residual_speed_bias : float
@@ -228,7 +228,7 @@ def check_work(
     resolution: float,
     max_scenes: int | None,
 ) -> None:
-    """:class:`WorkBoundError` if :func:`work_estimate` passes ``max_scenes``."""
+    """:class:`WorkBoundError` if ``work_estimate`` passes ``max_scenes``."""
     scenes, lines, per_line = work_estimate(shots, sphere, speeds, resolution)
     if max_scenes is not None and scenes > max_scenes:
         raise WorkBoundError(
@@ -332,7 +332,7 @@ def validate(
     when every shot has weight 0 (nothing to score), :class:`ParameterError` for a
     tolerance or resolution out of range, and
     :class:`~plateimpact.base.errors.WorkBoundError` when the shots' scenes and the boundary
-    search could together pass ``max_scenes`` (None: no bound; :func:`work_estimate`).
+    search could together pass ``max_scenes`` (None: no bound; ``work_estimate``).
     The shots run RUN_CHUNK at a time.
     """
     if not shots.weight.sum() > 0.0:

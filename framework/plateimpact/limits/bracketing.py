@@ -130,7 +130,7 @@ def locate(
 ) -> Located:
     """Every regime change along the lines [starts, ends], each bracketed to within
     ``tolerance`` (same unit as the positions); :class:`ParameterError` (``tolerance``)
-    for a tolerance finer than :func:`finest_tolerance` of the lines, before any
+    for a tolerance finer than ``finest_tolerance`` of the lines, before any
     evaluation, or if a pass fails to shrink a bracket. Lines whose scans hold more than
     GROUP_SCENES samples are located a group at a time (what is held grows with a
     group, not with the request); a single line may hold at most GROUP_SCENES."""

@@ -72,7 +72,7 @@ def _grid_axes(
 class SceneBatch:
     """Per-scene parameters as 1-D float arrays of equal length.
 
-    Columns are read as attributes (``batch.radius``): :data:`CORE_COLUMNS`, then the
+    Columns are read as attributes (``batch.radius``): ``CORE_COLUMNS``, then the
     plate constants. Inside the step loop a plug-in sees its own view of the bound batch
     (:class:`~plateimpact.model.binding.BoundBatch`): the core columns, the plate constants it
     declared and the per-scene columns it prepared.

@@ -173,7 +173,7 @@ def contact_surface(
     of the incidence ψ = θ − φ (eq 22), and sin θ, cos θ at ``penetration`` P [m],
     ``obliquity`` θ [rad] in [0, π] and ``radius`` Rs [m], one per scene
     (:func:`contact_surface_kernel`: for numbers). What
-    :func:`~plateimpact.model.resistance.force_on_contact` needs."""
+    ``plateimpact.model.resistance.force_on_contact`` needs."""
     penetration = np.asarray(penetration, dtype=float)
     obliquity = np.asarray(obliquity, dtype=float)
     radius = np.asarray(radius, dtype=float)

@@ -104,7 +104,7 @@ class ImpactModel:
 
     def bind(self, batch: SceneBatch) -> BoundBatch:
         """The batch with every per-scene constant the step loop needs
-        (:func:`~plateimpact.model.binding.bind_scenes`), computed once."""
+        (``plateimpact.model.binding.bind_scenes``), computed once."""
         plugins = list(self.plugins())
         return bind_scenes(plugins, self.failure.onset_penetration, self.rest_speed_fraction, batch)
 
@@ -155,7 +155,7 @@ class ImpactModel:
         """Net drag and lift [N] on every scene (eqs 1, 15, 21–24).
 
         The failure model is consulted only for the scenes whose plate has failed.
-        θ < 0 is the mirror image of |θ| (a path that has swung across the plate normal,
+        θ < 0 is the mirror image of ``|θ|`` (a path that has swung across the plate normal,
         which an explicit step near normal incidence can overshoot): the same drag, the
         lift reversed. The plug-ins only ever see θ >= 0 (docs/model.md, "mirror").
         """
@@ -289,8 +289,9 @@ class ImpactModel:
 
     def branch_margins(self, y: np.ndarray, failed: np.ndarray, batch: BoundBatch) -> np.ndarray:
         """Margins that cross zero where the force changes formula, shape (rows, n): the
-        contact geometry's branch surfaces (:func:`geometry.branch_margins`), then the
-        failure model's rows (:meth:`FailureModel.branch_margins`), NaN for intact scenes.
+        contact geometry's branch surfaces
+        (:func:`plateimpact.model.geometry.branch_margins`), then the failure model's rows
+        (:meth:`FailureModel.branch_margins`), NaN for intact scenes.
 
         Not events: nothing changes there but the smoothness of the force. The adaptive
         step control steps onto such a surface rather than across it.

@@ -22,7 +22,7 @@ class ResistanceLaw(Plugin, ABC):
 
     To write one: subclass, set ``name``, declare the plate constants it reads in
     ``plate_constants``, implement :meth:`stress` on arrays, and register the class from
-    a ``plateimpact_register`` hook (:mod:`plateimpact.registry.hookspecs`). Settings are attrs
+    a ``plateimpact_register`` hook (:func:`plateimpact.hookimpl`). Settings are attrs
     fields. ``stress`` runs inside the step loop: numpy only, no Python loop over
     scenes, no hook calls.
 
@@ -79,7 +79,7 @@ def force_on_surface(
     stress: Callable[..., Any],
     stress_args: tuple[Any, ...],
 ) -> tuple[Any, Any]:
-    """:func:`force_on_contact` from the contact ``surface`` already evaluated at
+    """``force_on_contact`` from the contact ``surface`` already evaluated at
     ``obliquity`` θ [rad] (the geometry's A [m²], φ [rad], cos ψ, sin ψ, ...), at
     ``speed`` V [m/s]: drag and lift [N] (eqs 1, 22–24)."""
     area, inclination, cos_incidence, sin_incidence = surface[0], surface[1], surface[2], surface[3]
@@ -96,7 +96,7 @@ def contact_force(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Drag and lift [N] of ``law`` on the contact surface (eqs 1, 22–24) at
     ``penetration`` P [m], ``obliquity`` θ [rad] and ``speed`` V [m/s], one per scene
-    (:func:`force_on_contact` on arrays).
+    (``force_on_contact`` on arrays).
 
     ``penetration`` is measured from the plane bounding the resisting material: the front
     surface for the intact force F*, the failure plane (P − h) for the relieved force F′

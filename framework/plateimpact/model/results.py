@@ -167,9 +167,9 @@ class BatchResult:
 
     ``trajectory`` (when recorded) and ``craters`` (when asked for) are
     :class:`~plateimpact.model.ragged.Ragged` arrays with one row per scene: the trajectory's
-    columns are :data:`TRAJECTORY_FIELDS` then ``failure_<state>``; the craters' are
+    columns are ``TRAJECTORY_FIELDS`` then ``failure_<state>``; the craters' are
     ``lateral`` and ``depth`` per point and ``impact_point`` per scene
-    (:data:`CRATER_FIELDS`). ``stats`` counts the integrator's work. ``inputs``, when
+    (``CRATER_FIELDS``). ``stats`` counts the integrator's work. ``inputs``, when
     attached, are the scenes they are of (with their plate constants' declarations):
     :meth:`to_xarray` and :meth:`to_dataframe` give them as coordinates.
     """
@@ -233,7 +233,7 @@ class BatchResult:
     def to_xarray(self) -> xarray.Dataset:
         """The results as an xarray Dataset over ``scene`` [SI, CF ``units``], the scenes'
         inputs as coordinates (as the archive's run file has them): every column of
-        :data:`RESULT_FIELDS`, the outcome and plate failure as CF flags."""
+        ``RESULT_FIELDS``, the outcome and plate failure as CF flags."""
         return self._table().to_xarray()
 
     def to_dataframe(self) -> pandas.DataFrame:

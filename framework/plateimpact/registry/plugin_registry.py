@@ -72,7 +72,7 @@ def _flag_list(kind: str, cls: type[Plugin]) -> list[tuple[str, str]]:
 
 class PluginRegistry(Choices):
     """Name → class tables, one per kind of plug-in, and the plate constants they declare;
-    the defaults, presets and sphere packages declare (:class:`~.choices.Choices`).
+    the defaults, presets and sphere packages declare (``plateimpact.registry.choices.Choices``).
 
     Registering checks a class's declarations: a plate constant may be declared by several
     plug-ins only with equal declarations, so that a plate's ``a`` means one thing
@@ -192,7 +192,7 @@ class PluginRegistry(Choices):
 
     def origin(self, kind: str, name: str) -> PluginOrigin | None:
         """The distribution and entry point that registered the ``name`` plug-in (see
-        :func:`plugin_origin`)."""
+        ``plugin_origin``)."""
         return plugin_origin(self.get(kind, name))
 
     def declared_by(self, constant: str) -> list[str]:

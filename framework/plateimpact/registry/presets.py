@@ -7,7 +7,7 @@ plug-in packages (they register them; the core knows none).
 >>> presets.DEFAULT_SPHERE       # the sphere used unless one is given
 >>> presets.SPHERE_DENSITY       # its density [kg/m³], which a sphere of another radius keeps
 
-Read from :func:`~.plugin_registry.default_registry` (the installed packages) on first use;
+Read from :func:`~plateimpact.default_registry` (the installed packages) on first use;
 code that holds a registry reads ``registry.plate(name)``, ``registry.plates`` and
 ``registry.sphere`` instead.
 """

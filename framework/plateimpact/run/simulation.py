@@ -60,7 +60,7 @@ class Simulation:
 
     model: ImpactModel
     integrator: Integrator = attrs.field(validator=_integrator)
-    #: "auto" (default), "compiled" or "numpy" (:data:`~plateimpact.solve.driver.ENGINES`):
+    #: "auto" (default), "compiled" or "numpy" (``plateimpact.solve.driver.ENGINES``):
     #: how runs are integrated; the two paths agree to rounding (docs/integrators.md).
     engine: str = attrs.field(default="auto", kw_only=True, validator=_engine)
     registry: PluginRegistry = attrs.field(
@@ -128,7 +128,7 @@ class Simulation:
         each run as one batch in a worker, and the results come back in order. A scene's
         result does not depend on the rest of its batch, so chunking changes nothing but
         the wall time. Threads gain nothing (the step loop holds the GIL between numpy
-        calls): use processes. Inside :func:`~plateimpact.run.progress.reporting_scenes`
+        calls): use processes. Inside ``plateimpact.run.progress.reporting_scenes``
         each finished chunk advances its progress bar.
         """
         batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)

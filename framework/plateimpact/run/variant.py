@@ -136,6 +136,7 @@ class Variant:
         )
 
     def to_json(self) -> str:
+        """The variant as JSON text: every field, keys sorted (:meth:`from_json` reads it)."""
         return json.dumps(attrs.asdict(self), sort_keys=True)
 
     @classmethod

@@ -103,12 +103,12 @@ class Archive(ArchiveFiles):
     ) -> str:
         """Add one finished run of ``study`` (atomically) as ``run`` (default: the
         variant's name); returns its name ``STUDY/RUN``. A run of that name is replaced
-        with ``overwrite`` and otherwise refused (:class:`RunExistsError`).
+        with ``overwrite`` and otherwise refused (``RunExistsError``, an :class:`ArchiveError`).
 
         ``constants`` are the declarations of the plate constants the run's plug-ins read
         (units and descriptions of the scene columns). If another writer keeps the
         archive longer than ``wait``, the run is saved to a side archive beside it and
-        :class:`ArchiveBusyError` says where: a finished run is never lost."""
+        ``ArchiveBusyError`` (an :class:`ArchiveError`) says where: a finished run is never lost."""
         self.check_writable(study.name)
         name = run or variant.name
         stored = self._append(

@@ -71,7 +71,7 @@ class Shots:
     Attributes
     ----------
     impact_speed : numpy.ndarray
-        Vs [m/s], in the range of :data:`~plateimpact.model.scene.IMPACT_SPEED`.
+        Vs [m/s], in the range of ``plateimpact.model.scene.IMPACT_SPEED``.
     impact_obliquity : numpy.ndarray
         θs [rad], in [0, π/2).
     residual_speed : numpy.ndarray
@@ -84,7 +84,7 @@ class Shots:
         :class:`~plateimpact.Outcome` values, 0 where only go/no-go is known.
     labels : sequence of str
         Where each shot came from (``shots.csv line 7``), for error messages: a tuple, or
-        from a file a :class:`ShotLabels` (line numbers, each label made when asked).
+        from a file a ``ShotLabels`` (line numbers, each label made when asked).
     source : str
         The file (or ``"shots"``), for error messages about the whole set.
     perforated : numpy.ndarray

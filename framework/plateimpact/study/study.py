@@ -390,6 +390,6 @@ class StudyResults:
 
     def compare(self, run_a: str, run_b: str) -> Comparison:
         """Run B against run A: per scene Δ exit speed and obliquity (B − A), and the
-        outcome changes in ranges along each plate's rows (:mod:`plateimpact.comparison`)."""
+        outcome changes in ranges along each plate's rows (:class:`plateimpact.Comparison`)."""
         study = self.study
         return Comparison(run_a, run_b, self[run_a], self[run_b], study.scenes, study.plate_labels)
