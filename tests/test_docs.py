@@ -157,3 +157,13 @@ def test_the_pages_compiled_plug_in_runs_compiled_with_the_numpy_paths_results(d
     np.testing.assert_array_equal(runs["compiled"].outcome, runs["numpy"].outcome)
     speed = scenes.columns["impact_speed"]
     assert np.max(np.abs(runs["compiled"].exit_speed - runs["numpy"].exit_speed) / speed) <= 2e-7
+
+
+def test_the_pages_pyproject_is_the_packages_complete():
+    """The page shows the third-party package's pyproject.toml whole (its comments
+    aside), and it declares the entry point the package is found by."""
+    (toml,) = re.findall(r"```toml\n(.*?)```", (ROOT / "docs" / "plugins.md").read_text(), re.S)
+    project = (ROOT / "tests" / "third_party" / "pyproject.toml").read_text()
+    kept = [line for line in project.splitlines() if not line.startswith("#")]
+    assert toml.splitlines() == kept
+    assert '[project.entry-points.plateimpact]\nisotropic = "plateimpact_isotropic"' in toml

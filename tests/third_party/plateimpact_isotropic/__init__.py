@@ -88,6 +88,7 @@ class IsotropicPoncelet(ResistanceLaw):
         return isotropic_stress(speed, incidence, (scenes.a, scenes.b))
 
 
+# The package's one hook registers its plug-ins: this law and those further down.
 @hookimpl
 def plateimpact_register(registry: PluginRegistry) -> None:
     for cls in (IsotropicPoncelet, RatePoncelet, Brittle, ClassicalRungeKutta):
