@@ -1,4 +1,4 @@
-"""The ``plateimpact`` command: user units (mm, m/s, g, degrees) in and out.
+"""The plateimpact command: user units (mm, m/s, g, degrees) in and out.
 
 One module per command (:mod:`plateimpact.cli.commands`), each with ``arguments`` and
 ``run``; ``main`` lists them from a table and imports only the one invoked, builds one
