@@ -10,9 +10,13 @@ nitpicky build. The build also fails if a public name has no entry in the API re
 
 from __future__ import annotations
 
+import inspect
 import re
+import sys
 from pathlib import Path
 from typing import Any
+
+import attrs
 
 import plateimpact
 from plateimpact import _EXPORTS, _SUBMODULES
@@ -120,10 +124,35 @@ def no_signature_for_data(
     return () if what == "data" else None
 
 
+def attrs_init_defaults(app: Any, obj: Any, bound_method: bool) -> None:
+    """The defaults of an attrs class's ``__init__`` as values. With
+    ``autodoc_preserve_defaults`` autodoc shows defaults as the source writes them
+    (``obliquities=MAP_OBLIQUITIES``, not the array), but the source of the ``__init__``
+    attrs generates says ``attr_dict['unit'].default``. There a default shows as its repr,
+    or as the module-level name it is (``NO_DEFAULT``); a factory as ``<factory>``."""
+    code = getattr(obj, "__code__", None)
+    if code is None or not code.co_filename.startswith("<attrs generated"):
+        return
+    from sphinx.ext.autodoc.preserve_defaults import DefaultValue
+
+    vars(obj).pop("__signature__", None)  # preserve_defaults' version
+    module = vars(sys.modules[obj.__module__])
+    parameters = []
+    for parameter in inspect.signature(obj).parameters.values():
+        default = parameter.default
+        if default is not parameter.empty:
+            named = [k for k, v in module.items() if v is default and k.isupper()]
+            text = "<factory>" if default is attrs.NOTHING else (named or [repr(default)])[0]
+            parameter = parameter.replace(default=DefaultValue(text))
+        parameters.append(parameter)
+    obj.__signature__ = inspect.signature(obj).replace(parameters=parameters)
+
+
 def setup(app: Any) -> dict[str, Any]:
     app.connect("missing-reference", resolve)
     app.connect("builder-inited", check_every_public_name_listed)
     app.connect("autodoc-process-docstring", doc_comment_of_public_data)
     app.connect("autodoc-process-signature", no_signature_for_data, priority=400)
+    app.connect("autodoc-before-process-signature", attrs_init_defaults)
     app.config.autosummary_context = {"exported": sorted(_EXPORTS)}
     return {"version": plateimpact.__version__, "parallel_read_safe": True}

@@ -35,8 +35,8 @@ class Plugin:
     """Base of :class:`~plateimpact.ResistanceLaw`, :class:`~plateimpact.FailureModel`
     and :class:`~plateimpact.Integrator`.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         The name users select it by.
     version : str
