@@ -1,6 +1,6 @@
 """Sphinx configuration of the plateimpact documentation site.
 
-Build (README, "Documentation"): ``pip install ".[docs]"`` then
+Build (README, Quick start, third line): ``pip install ".[docs]"`` then
 ``sphinx-build -W --keep-going -n -b html docs docs/_build/html``. The Markdown pages are
 read by myst-parser, the API reference (``api/``) is generated from the docstrings by
 autodoc and autosummary (numpydoc sections), and the gallery is the scripts of
@@ -17,10 +17,10 @@ from pathlib import Path
 import plateimpact
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))  # _ext: the resolver of our own short names below
+sys.path.insert(0, str(HERE))  # _ext: the build's own extensions
 
-# Gallery scripts and anything else the build runs: the numpy path (no compilation on
-# the build machine), and a cache of compiled programs that cannot touch the user's.
+# The gallery's scripts start no compiling of the fast path (docs/integrators.md): they
+# run on the numpy path unless numba and compiled programs are already there.
 os.environ.setdefault("PLATEIMPACT_COMPILE", "off")
 os.environ.setdefault("MPLBACKEND", "Agg")
 # Without numba (the docs extra does not bring it) "auto" says once per run that it takes
@@ -55,7 +55,6 @@ myst_enable_extensions = ["dollarmath"]
 
 # -- API reference ----------------------------------------------------------------------
 autosummary_generate = True
-autosummary_imported_members = True
 autodoc_default_options = {"members": True}
 autodoc_member_order = "bysource"
 # Signatures show the names of the arguments; their units and meaning are in the
@@ -72,7 +71,6 @@ sphinx_gallery_conf = {
     "examples_dirs": "examples",
     "gallery_dirs": "gallery",
     "filename_pattern": r".*\.py$",  # every script runs at build time
-    "ignore_pattern": r"(__init__|_common)\.py$",
     "download_all_examples": False,
     "remove_config_comments": True,
     "within_subsection_order": "FileNameSortKey",
@@ -81,10 +79,8 @@ sphinx_gallery_conf = {
     "capture_repr": ("_repr_html_", "__repr__"),
     # a figure a cell ends with is drawn by the scrapers, not printed as "<Figure ...>"
     "ignore_repr_types": r"matplotlib\.figure\.Figure|xarray\.plot\.facetgrid\.FacetGrid",
-    "abort_on_example_error": False,
-    "only_warn_on_example_error": False,
     "show_memory": False,
-    "plot_gallery": "True",
+    # a script that raises is a warning, so an error with -W: the gallery cannot drift
 }
 
 # -- Cross-references -------------------------------------------------------------------
