@@ -20,6 +20,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 
 import plateimpact as pi
 from plateimpact import limits, presets
@@ -48,6 +49,13 @@ def figure_30_31(out: Path) -> Path:
 
 
 def figure_35(out: Path) -> Path:
+    path = out / "fig35_craters_6061T6_9.53mm_60deg.png"
+    saving.save(craters_figure_35(), str(path))
+    return path
+
+
+def craters_figure_35() -> Figure:
+    """Crater sections of the 9.53-mm plate at 60° and Figure 35's speeds (eqs 31–39)."""
     plate = presets.plate("6061-T6/9.53")
     simulation = pi.Simulation.from_names()
     fig, axes = style.figure(2, 1, figsize=(8, 7), layout="constrained")
@@ -59,9 +67,7 @@ def figure_35(out: Path) -> Path:
             f"6061-T6, 9.53 mm, 60°, {speed / 1e3:.3f} km/s: {result.outcome.label}, "
             f"crater {section.length / mm:.1f} × {section.max_depth / mm:.2f} mm"
         )
-    path = out / "fig35_craters_6061T6_9.53mm_60deg.png"
-    saving.save(fig, str(path))
-    return path
+    return fig
 
 
 def hinge_geometry(out: Path) -> Path:

@@ -16,12 +16,9 @@ the figure it draws. Then the crater sections of Figure 35 (the 9.53-mm 6061-T6 
 # the numpy path in about a second.
 import numpy as np
 
-import plateimpact as pi
-from plateimpact import presets
-from plateimpact.figures import crater_sections, exit_curves, style
-from plateimpact.model.crater import crater_section
-from plateimpact.units import deg, mm
+from plateimpact.figures import exit_curves
 from plateimpact_studies.fig25_31_2024t3_3_18mm import study
+from plateimpact_studies.report_figures import craters_figure_35
 
 family = study()
 results = family.run()
@@ -50,18 +47,8 @@ at_60.groupby(level="variant", sort=False)["outcome"].value_counts().unstack(fil
 # %%
 # Crater sections: Figure 35
 # --------------------------
-# One scene each, its path recorded; the section is the trace the sphere leaves in the
-# plate (eqs 31–39), as deep as it went.
-plate = presets.plate("6061-T6/9.53")
-sphere = presets.DEFAULT_SPHERE
-simulation = pi.Simulation.from_names()
-fig, axes = style.figure(2, 1, figsize=(7.2, 6.4), layout="constrained")
-for ax, speed in zip(axes, (263.0, 737.0), strict=True):
-    result = simulation.run(pi.Scene(sphere, plate, speed, 60 * deg), record_trajectory=True)
-    section = crater_section(result.trajectory, sphere.radius, thickness=plate.thickness)
-    crater_sections.plot_crater(ax, section, trajectory=result.trajectory, radius=sphere.radius)
-    ax.set_title(
-        f"6061-T6, 9.53 mm, 60°, {speed:g} m/s: {result.outcome.label}, "
-        f"crater {section.length / mm:.1f} × {section.max_depth / mm:.2f} mm"
-    )
-fig
+# One scene at each speed, its path recorded; the section is the trace the sphere leaves
+# in the plate (eqs 31–39), as deep as it went (``studies/report_figures.py`` draws it
+# for the report's figures).
+figure = craters_figure_35()
+figure
