@@ -73,7 +73,7 @@ sphinx_gallery_conf = {
     "filename_pattern": r".*\.py$",  # every script runs at build time
     "download_all_examples": False,
     "remove_config_comments": True,
-    "within_subsection_order": "FileNameSortKey",
+    "within_subsection_order": "_ext.gallery_order.ReadingOrder",
     # pyplot's figures (xarray plots through it), and plateimpact's, made outside pyplot
     "image_scrapers": ("matplotlib", "_ext.figure_scraper.figures_in_namespace"),
     "capture_repr": ("_repr_html_", "__repr__"),
