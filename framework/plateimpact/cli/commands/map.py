@@ -13,7 +13,8 @@ import numpy as np
 
 from ... import limits as lim
 from ...limits.regimes import Regime
-from ...model.scene import IMPACT_OBLIQUITY
+from ...model.results import RESULT_FIELDS
+from ...model.scene import IMPACT_OBLIQUITY, IMPACT_SPEED
 from ...registry.plugin_registry import PluginRegistry
 from ...run.progress import reporting_scenes
 from ...storage.together import write_together
@@ -25,7 +26,7 @@ from ..common import (
     figure_output,
     text_output,
 )
-from ..formatting import shown
+from ..formatting import shown, user
 from ..limit_options import (
     add_archive_options,
     finite_number,
@@ -127,6 +128,7 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     return 0
 
 
+EXIT_OBLIQUITY = RESULT_FIELDS["exit_obliquity"]
 #: A cell's columns, in user units (as ``export`` names them).
 CELL_COLUMNS = ("plate", "impact_obliquity_deg", "impact_speed_m_s", "outcome", "plate_failed",
                 "exit_speed_m_s", "exit_obliquity_deg")  # fmt: skip
@@ -141,9 +143,10 @@ def _cells(label: str, found: lim.OutcomeMap) -> list[list[Any]]:
             regime = Regime.of_code(int(found.regime[i, j]))
             angle = float(found.exit_obliquity[i, j])
             rows.append([
-                label, math.degrees(float(obliquity)), float(speed), regime.outcome.label,
-                regime.plate_failed, float(found.exit_speed[i, j]),
-                None if not math.isfinite(angle) else math.degrees(angle),
+                label, user(IMPACT_OBLIQUITY, obliquity), user(IMPACT_SPEED, speed),
+                regime.outcome.label, regime.plate_failed,
+                user(RESULT_FIELDS["exit_speed"], found.exit_speed[i, j]),
+                user(EXIT_OBLIQUITY, angle) if math.isfinite(angle) else None,
             ])  # fmt: skip
     return rows
 
@@ -157,17 +160,17 @@ def _json(label: str, found: lim.OutcomeMap) -> dict[str, object]:
     """One map: its axes, its cells row by row (obliquities) in user units, and the
     bands along each row as ``limits --json`` gives them."""
 
-    def grid(values: np.ndarray, scale: float = 1.0) -> list[list[float | None]]:
-        return [[float(v) / scale if math.isfinite(v) else None for v in row] for row in values]
+    def grid(values: np.ndarray, declared: Any) -> list[list[float | None]]:
+        return [[user(declared, v) if math.isfinite(v) else None for v in row] for row in values]
 
     regimes = [[Regime.of_code(int(c)) for c in row] for row in found.regime]
     return {
         "preset": label,
-        "impact_speed_m_s": [float(v) for v in found.speeds],
-        "impact_obliquity_deg": [math.degrees(float(v)) for v in found.obliquities],
+        "impact_speed_m_s": [user(IMPACT_SPEED, v) for v in found.speeds],
+        "impact_obliquity_deg": [user(IMPACT_OBLIQUITY, v) for v in found.obliquities],
         "outcome": [[r.outcome.label for r in row] for row in regimes],
         "plate_failed": [[r.plate_failed for r in row] for row in regimes],
-        "exit_speed_m_s": grid(found.exit_speed),
-        "exit_obliquity_deg": grid(found.exit_obliquity, math.pi / 180.0),
+        "exit_speed_m_s": grid(found.exit_speed, RESULT_FIELDS["exit_speed"]),
+        "exit_obliquity_deg": grid(found.exit_obliquity, EXIT_OBLIQUITY),
         "limits": found.limits.to_json(),
     }
