@@ -32,10 +32,6 @@ from .style import COLUMN_WIDTH, FONT, PAGE_WIDTH, SMALL, figure, regime_colour,
 _DEG = math.pi / 180.0
 
 
-def _key(ax: Axes, regimes: Sequence[Regime], **kwargs: Any) -> None:
-    ax.legend(handles=regime_key(regimes), fontsize="small", **kwargs)
-
-
 def _model_line(model: dict[str, object]) -> str:
     return f"{model.get('resistance')} + {model.get('failure')}, {model.get('integrator')}"
 

@@ -155,10 +155,6 @@ def write_scenes_file(
                       **attributes})  # fmt: skip
 
 
-#: The global attributes CF asks of every file (§2.6.2), besides those the archive stores.
-OWN_LABELS = ("Conventions", "title", "history")
-
-
 def described(what: str, attributes: Mapping[str, object]) -> dict[str, str]:
     """A data file's ``Conventions``, ``title`` and ``history`` (CF §2.6.2): what it holds
     and, for a run, when it started (a study's scenes file carries no time, so that

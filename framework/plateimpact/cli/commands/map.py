@@ -128,49 +128,49 @@ def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
     return 0
 
 
-EXIT_OBLIQUITY = RESULT_FIELDS["exit_obliquity"]
 #: A cell's columns, in user units (as ``export`` names them).
 CELL_COLUMNS = ("plate", "impact_obliquity_deg", "impact_speed_m_s", "outcome", "plate_failed",
                 "exit_speed_m_s", "exit_obliquity_deg")  # fmt: skip
 
 
-def _cells(label: str, found: lim.OutcomeMap) -> list[list[Any]]:
-    """One row per cell (obliquities outer, speeds inner); no exit obliquity (empty)
-    where the sphere stays in the plate."""
-    rows = []
-    for i, obliquity in enumerate(found.obliquities):
-        for j, speed in enumerate(found.speeds):
-            regime = Regime.of_code(int(found.regime[i, j]))
-            angle = float(found.exit_obliquity[i, j])
-            rows.append([
-                label, user(IMPACT_OBLIQUITY, obliquity), user(IMPACT_SPEED, speed),
-                regime.outcome.label, regime.plate_failed,
-                user(RESULT_FIELDS["exit_speed"], found.exit_speed[i, j]),
-                user(EXIT_OBLIQUITY, angle) if math.isfinite(angle) else None,
-            ])  # fmt: skip
-    return rows
+def _grid(found: lim.OutcomeMap) -> dict[str, list[list[Any]]]:
+    """The map's cells row by row (obliquities) in user units, by the key ``--json``
+    gives them: outcome, plate state, exit speed and exit obliquity (None where there is
+    no number)."""
 
-
-def _csv(maps: list[tuple[str, lim.OutcomeMap]]) -> str:
-    rows = [row for label, found in maps for row in _cells(label, found)]
-    return csv_text(CELL_COLUMNS, [["" if v is None else v for v in row] for row in rows])
-
-
-def _json(label: str, found: lim.OutcomeMap) -> dict[str, object]:
-    """One map: its axes, its cells row by row (obliquities) in user units, and the
-    bands along each row as ``limits --json`` gives them."""
-
-    def grid(values: np.ndarray, declared: Any) -> list[list[float | None]]:
+    def numbers(values: np.ndarray, declared: Any) -> list[list[float | None]]:
         return [[user(declared, v) if math.isfinite(v) else None for v in row] for row in values]
 
     regimes = [[Regime.of_code(int(c)) for c in row] for row in found.regime]
     return {
+        "outcome": [[r.outcome.label for r in row] for row in regimes],
+        "plate_failed": [[r.plate_failed for r in row] for row in regimes],
+        "exit_speed_m_s": numbers(found.exit_speed, RESULT_FIELDS["exit_speed"]),
+        "exit_obliquity_deg": numbers(found.exit_obliquity, RESULT_FIELDS["exit_obliquity"]),
+    }
+
+
+def _csv(maps: list[tuple[str, lim.OutcomeMap]]) -> str:
+    """One row per cell of every map (obliquities outer, speeds inner); an empty field
+    where there is no number."""
+    rows = []
+    for label, found in maps:
+        cells = _grid(found)
+        for i, obliquity in enumerate(found.obliquities):
+            for j, speed in enumerate(found.speeds):
+                row = [label, user(IMPACT_OBLIQUITY, obliquity), user(IMPACT_SPEED, speed)]
+                row += [cells[key][i][j] for key in CELL_COLUMNS[3:]]
+                rows.append(["" if v is None else v for v in row])
+    return csv_text(CELL_COLUMNS, rows)
+
+
+def _json(label: str, found: lim.OutcomeMap) -> dict[str, object]:
+    """One map: its axes, its cells (:func:`_grid`), and the bands along each row as
+    ``limits --json`` gives them."""
+    return {
         "preset": label,
         "impact_speed_m_s": [user(IMPACT_SPEED, v) for v in found.speeds],
         "impact_obliquity_deg": [user(IMPACT_OBLIQUITY, v) for v in found.obliquities],
-        "outcome": [[r.outcome.label for r in row] for row in regimes],
-        "plate_failed": [[r.plate_failed for r in row] for row in regimes],
-        "exit_speed_m_s": grid(found.exit_speed, RESULT_FIELDS["exit_speed"]),
-        "exit_obliquity_deg": grid(found.exit_obliquity, EXIT_OBLIQUITY),
+        **_grid(found),
         "limits": found.limits.to_json(),
     }
