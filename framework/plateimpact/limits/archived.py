@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..base.errors import ArchiveError, ParameterError, PlateImpactError
+from ..base.errors import ArchiveError, ParameterError
 from ..base.untrusted import printable
 from ..model.bodies import THICKNESS, Plate, Sphere
 from ..provenance.metadata import git_commit, versions
@@ -26,7 +26,7 @@ from ..registry.plugin_registry import PluginRegistry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import FORMAT as PLATE_FORMAT
-from ..storage.records import Record, stored
+from ..storage.records import Record, reading, stored
 from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
 from .plate_limits import Limits
@@ -204,26 +204,16 @@ def read_limits(
 
 def _read_back(record: Record, what: str, registry: PluginRegistry | None) -> Limits | OutcomeMap:
     """:func:`from_record`, every failure an ArchiveError naming ``what`` (one line)."""
-    try:
+    with reading(what):
         return from_record(record, what, registry)
-    except ArchiveError:
-        raise
-    except (KeyError, ValueError, TypeError, IndexError, AttributeError, PlateImpactError) as exc:
-        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
-        raise ArchiveError(
-            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
-        ) from None
 
 
 def cf_record(record: Record, what: str, registry: PluginRegistry) -> Record:
     """The stored limits or map ``record`` (either layout), as this plateimpact writes
     it: its attributes as stored, its columns over their dimensions (for export)."""
-    found = _read_back(record, what, registry)
-    try:
-        columns = record_columns(found)
-    except ParameterError as exc:  # a map whose lines are not its rows
-        raise ArchiveError(f"{what} cannot be read back ({exc}); the record is damaged") from None
-    return Record(record.attributes, columns, _title(found))
+    with reading(what):  # a map whose lines are not its rows, too
+        found = from_record(record, what, registry)
+        return Record(record.attributes, record_columns(found), _title(found))
 
 
 #: Each kind's :func:`cf_record`, for ``plateimpact export --record``.

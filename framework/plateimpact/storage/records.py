@@ -19,7 +19,8 @@ as they are (:func:`stored` finds a column under either name).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import contextlib
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import BinaryIO
 
@@ -27,7 +28,7 @@ import attrs
 import h5py
 import numpy as np
 
-from ..base.errors import ArchiveError, ParameterError
+from ..base.errors import ArchiveError, ParameterError, PlateImpactError
 from ..base.untrusted import printable
 from .append import append_with
 from .data_files import DataFiles
@@ -170,6 +171,22 @@ def write_record(
     target = files.new(f"{LIMITS}.{stored}", lambda handle: write_record_file(handle, record))
     container[stored] = h5py.ExternalLink(target, "/")
     return stored
+
+
+@contextlib.contextmanager
+def reading(what: str) -> Iterator[None]:
+    """Turn what reading a record's values may raise (a record comes from a file, maybe
+    someone else's: a column missing, of the wrong shape or type) into one
+    ArchiveError naming ``what``."""
+    try:
+        yield
+    except ArchiveError:
+        raise
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError, PlateImpactError) as exc:
+        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
+        raise ArchiveError(
+            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
+        ) from None
 
 
 def dimension_sizes(columns: Mapping[str, RecordColumn]) -> dict[str, int]:

@@ -20,7 +20,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from ..base.errors import ArchiveError, PlateImpactError
+from ..base.errors import ArchiveError
 from ..base.untrusted import printable
 from ..provenance.code import limits_record, plugins_record
 from ..provenance.metadata import git_commit, versions
@@ -29,7 +29,7 @@ from ..run.simulation import Simulation
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
-from ..storage.records import LIMITS, Record, RecordColumn
+from ..storage.records import LIMITS, Record, RecordColumn, reading
 from ..study.reruns import StaleRunError, check_code
 from .curves import OutcomeGrid
 from .inputs import input_table
@@ -265,17 +265,10 @@ def _read_back(
 ) -> Found:
     """``read(record, what)`` of a record made for ``spec``; ArchiveError, one line, for
     a record of another spec or one that is damaged (it comes from a file)."""
-    try:
+    with reading(what):
         if typed.text(record.attributes, "spec_sha256", what) != spec_digest(spec):
             raise ArchiveError(f"{what} was made for another spec")
         return read(record, what)
-    except ArchiveError:
-        raise
-    except (KeyError, ValueError, TypeError, IndexError, PlateImpactError) as exc:
-        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
-        raise ArchiveError(
-            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
-        ) from None
 
 
 def _columns(record: Record, what: str, registry: PluginRegistry) -> dict[str, RecordColumn]:
@@ -308,18 +301,10 @@ def _columns(record: Record, what: str, registry: PluginRegistry) -> dict[str, R
 def cf_record(record: Record, what: str, registry: PluginRegistry) -> Record:
     """The stored ``record`` of an uncertainty study (either layout) as this plateimpact
     writes it: its attributes as stored, its columns over their dimensions (export)."""
-    try:
-        columns = _columns(record, what, registry)
+    with reading(what):
         kind = typed.text(record.attributes, "kind", what)
         title = _title(kind, typed.json_value(record.attributes, "plate", what, dict))
-    except ArchiveError:
-        raise
-    except (KeyError, ValueError, TypeError, IndexError, PlateImpactError) as exc:
-        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
-        raise ArchiveError(
-            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
-        ) from None
-    return Record(record.attributes, columns, title)
+        return Record(record.attributes, _columns(record, what, registry), title)
 
 
 #: Each kind's :func:`cf_record`, for ``plateimpact export --record``.
