@@ -42,14 +42,18 @@ def files(tmp_path_factory) -> list[Path]:
 
 @pytest.fixture(scope="module")
 def records(tmp_path_factory) -> list[Path]:
-    """Every kind of stored record, tiny (two lines, a 2 x 4 map, four samples), and
-    the map exported."""
+    """Every kind of stored record, tiny (two lines, a 2 x 4 map, four samples), limits
+    with no boundary (a dimension of size 0), and the map exported."""
     where = tmp_path_factory.mktemp("cf-records")
     archive, simulation = where / "r.h5", pi.Simulation.from_names()
     sphere, plate = presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18")
     found = limits.along_speed(simulation, sphere, plate, np.radians([0.0, 45.0]),
                                (100.0, 900.0), resolution=50.0)  # fmt: skip
     limits.archive_limits(archive, "bands", found)
+    thin = presets.plate("2024-T3/1.27")  # perforated at every speed: no boundary at all
+    none = limits.along_speed(simulation, sphere, thin, [0.0], (1500.0, 2000.0), resolution=100.0)
+    assert not none.lines[0].boundaries
+    limits.archive_limits(archive, "none", none)
     grid = limits.outcome_map(simulation, sphere, plate, (100.0, 1000.0), 4, np.radians([0, 60]))
     limits.archive_limits(archive, "map", grid)
     spec = {"preset": "2024-T3/3.18", "failure": "plugging", "samples": 4, "seed": 6,
@@ -68,7 +72,7 @@ def records(tmp_path_factory) -> list[Path]:
     code, _, err = run_cli(["export", str(archive), "--record", "map", "--to", str(exported)])
     assert code == 0, err
     stored = sorted((where / "r.h5.d").glob("limits.*.nc"))
-    assert len(stored) == 5  # limits, map, and the uncertainty study's three
+    assert len(stored) == 6  # two limits, a map, and the uncertainty study's three
     return [*stored, exported]
 
 
@@ -121,12 +125,14 @@ def test_a_record_is_labelled_by_its_dimensions(records):
     """Each record's variables over the axes they truly index: a map's grid over its
     obliquities and speeds, which are its lines too; limits' lines with their fixed
     obliquity; the uncertainty study's samples, inputs and points."""
-    kinds = {data.attrs["kind"]: data for data in map(opened, records[:-1])}
-    grid = kinds["outcome_map"]
+    named = {path.name.split(".")[1]: opened(path) for path in records[:-1]}
+    kinds = {data.attrs["kind"]: data for data in named.values()}
+    grid = named["map"]
     assert grid["regime"].dims == ("impact_obliquity", "impact_speed")
     assert grid["ballistic_limit"].dims == ("impact_obliquity",)
     assert grid["impact_speed"].attrs["units"] == "m/s" and grid.sizes["impact_speed"] == 4
-    bands = kinds["limits"]
+    assert named["none"].sizes["boundary"] == 0 and named["none"].sizes["line"] == 1
+    bands = named["bands"]
     np.testing.assert_array_equal(bands["impact_obliquity"], np.radians([0.0, 45.0]))
     assert bands["ballistic_limit"].dims == ("line",) and "impact_obliquity" in bands.coords
     assert set(bands["boundary_line"].values) == {0, 1}

@@ -24,7 +24,7 @@ SPHERE, PLATE = presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18")
 
 @pytest.fixture(scope="module")
 def found() -> dict[str, limits.Limits | limits.OutcomeMap]:
-    """Tiny limits of both kinds of line, and a tiny map."""
+    """Tiny limits of both kinds of line, a tiny map, and limits with no boundary."""
     simulation = pi.Simulation.from_names()
     return {
         "speed": limits.along_speed(simulation, SPHERE, PLATE, np.radians([0.0, 45.0]),
@@ -33,6 +33,8 @@ def found() -> dict[str, limits.Limits | limits.OutcomeMap]:
                                             resolution=math.radians(5.0)),
         "map": limits.outcome_map(simulation, SPHERE, PLATE, (100.0, 1000.0), 4,
                                   np.radians([0.0, 30.0, 60.0])),
+        "none": limits.along_speed(simulation, SPHERE, presets.plate("2024-T3/1.27"), [0.0],
+                                   (1500.0, 2000.0), resolution=100.0),  # perforated only
     }  # fmt: skip
 
 
