@@ -5,6 +5,7 @@ flag or kind is one line (docs/archive.md, "Limits and outcome maps")."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import h5py
@@ -18,6 +19,7 @@ from test_output_files import assert_one_line, old_file, run_cli
 import plateimpact as pi
 from plateimpact import limits, presets
 from plateimpact.storage.records import Record, RecordColumn, index_column
+from plateimpact.uncertainty.record_columns import map_columns
 
 SPHERE, PLATE = presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18")
 
@@ -99,3 +101,18 @@ def test_a_column_without_its_dimensions_is_refused_before_writing(tmp_path):
         with pytest.raises(ValueError):
             pi.Archive(path).append_record("r", Record({"kind": "other"}, columns))
     assert not path.exists()
+
+
+def test_a_stored_record_whose_columns_disagree_exports_as_damage_in_one_line(tmp_path):
+    path, target = tmp_path / "a.h5", tmp_path / "out.nc"
+    counts = {o: np.ones((2, 2), dtype=np.int64) for o in ("ricochet", "embedment", "perforation")}
+    columns = map_columns(np.array([300.0, 600.0]), np.radians([0.0, 45.0]), counts)
+    plate = json.dumps({"material": "2024-T3", "thickness_mm": 3.18})
+    record = Record({"kind": "uncertainty_map", "plate": plate}, columns)
+    pi.Archive(path).append_record("m", record)
+    assert exported(path, "m", target)["ricochet_count"].shape == (2, 2)
+    with h5py.File(record_file(path, "m"), "a") as f:  # data are not sealed, only checksummed
+        del f["ricochet_count"]
+        f["ricochet_count"] = np.ones(3, dtype=np.int64)
+    code, _, err = run_cli(["export", str(path), "--record", "m", "--to", str(target)])
+    assert_one_line(code, err, "limits/m", "ricochet_count", "damaged")

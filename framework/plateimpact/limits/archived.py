@@ -39,7 +39,6 @@ JSON_ATTRIBUTES = ("plate", "model", "versions", "regimes")
 TEXT_ATTRIBUTES = ("kind", "axis", "axis_units", "tolerance_units", "resolution_units",
                    "git_commit", "host", "creation_time", "description")  # fmt: skip
 NUMBER_ATTRIBUTES = ("tolerance", "resolution", "scenes", "passes", "wall_time_s")
-__all__ = ["NAMES", "UNITS"]  # each axis's name and SI unit, for the listings
 
 
 def _title(found: Limits | OutcomeMap) -> str:
@@ -114,14 +113,13 @@ def from_record(
     index, low, high = (line_data(record, f"boundary_{k}") for k in ("line", "low", "high"))
     below, above = line_data(record, "regime_below"), line_data(record, "regime_above")
     fixed = stored(record, OTHER[axis], "lines/fixed")  # a map's: the rows of its grid
-    if fixed.shape != line_data(record, "line_start").shape:
-        raise ValueError(
-            f"{fixed.size} fixed coordinates for {line_data(record, 'line_start').size} lines"
-        )
+    starts = line_data(record, "line_start")
+    if fixed.shape != starts.shape:
+        raise ValueError(f"{fixed.size} fixed coordinates for {starts.size} lines")
     lines = []
     for i, (start, end, first) in enumerate(
-        zip(line_data(record, "line_start"), line_data(record, "line_end"),
-            line_data(record, "first_regime"), strict=True)
+        zip(starts, line_data(record, "line_end"), line_data(record, "first_regime"),
+            strict=True)
     ):  # fmt: skip
         mine = np.flatnonzero(index == i)
         boundaries = tuple(

@@ -27,7 +27,7 @@ from .append import StudyDefinition
 from .archive import Archive
 from .data_files import encoded
 from .netcdf import write_run_file
-from .records import LIMITS, Record, write_record_file
+from .records import LIMITS, Record, reading, write_record_file
 
 if TYPE_CHECKING:
     import xarray
@@ -139,8 +139,9 @@ def record_netcdf_bytes(
             f"{what} is of kind {printable(kind, 40)}, which this plateimpact does not "
             f"export (it exports {', '.join(convert)})"
         )
-    again = convert[kind](record, what, registry)
-    return encoded(lambda handle: write_record_file(handle, again))
+    with reading(what):  # columns that do not agree (a damaged record) are refused too
+        again = convert[kind](record, what, registry)
+        return encoded(lambda handle: write_record_file(handle, again))
 
 
 def table_header(archive: Archive, run: str, *, registry: PluginRegistry) -> list[str]:

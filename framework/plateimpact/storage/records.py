@@ -189,7 +189,7 @@ def reading(what: str) -> Iterator[None]:
         ) from None
 
 
-def dimension_sizes(columns: Mapping[str, RecordColumn]) -> dict[str, int]:
+def _dimension_sizes(columns: Mapping[str, RecordColumn]) -> dict[str, int]:
     """Each dimension the ``columns`` run over and its size; ValueError unless every
     column names one dimension per axis (at least one: checksums need chunks), each
     dimension has one size and a coordinate variable (a column of its name over it)."""
@@ -213,7 +213,7 @@ def write_record_file(where: BinaryIO, record: Record) -> None:
     global attributes with ``Conventions``, ``title`` and ``history``."""
     import h5netcdf  # noqa: PLC0415 (only archives need it)
 
-    sizes = dimension_sizes(record.columns)
+    sizes = _dimension_sizes(record.columns)
     first = sorted(record.columns, key=lambda name: name not in sizes)
     with h5netcdf.File(where, "w") as f:
         f.dimensions.update(sizes)

@@ -45,7 +45,7 @@ from .record_columns import (
     limits_data,
     map_columns,
     samples_of,
-)  # fmt: skip
+)
 from .sensitivity import SobolIndices
 from .spec import UncertaintySpec
 
