@@ -1,7 +1,10 @@
 """The netCDF files an archive and ``export`` write, checked by the IOOS compliance-checker
 against CF 1.11 (an independent reading of the conventions, installed from the test
 extra): every check at every priority passes, the global ``title`` and ``history`` (CF
-§2.6.2) included, and xarray opens each file with no warning."""
+§2.6.2) included, and xarray opens each file with no warning. The files: a run, its
+study's scenes and the run exported; a stored record of every kind (limits, an outcome
+map, an uncertainty study's sampled limits, Sobol' indices and probability map) and a
+record exported."""
 
 from __future__ import annotations
 
@@ -16,6 +19,7 @@ from compliance_checker.runner import CheckSuite, ComplianceChecker
 from test_output_files import run_cli
 
 import plateimpact as pi
+from plateimpact import limits, presets
 
 # the checker's own notice about a checker of another standard it loads alongside
 pytestmark = pytest.mark.filterwarnings("ignore:The ioos_sos checker is deprecated")
@@ -36,6 +40,42 @@ def files(tmp_path_factory) -> list[Path]:
     return [*data, exported]
 
 
+@pytest.fixture(scope="module")
+def records(tmp_path_factory) -> list[Path]:
+    """Every kind of stored record, tiny (two lines, a 2 x 4 map, four samples), limits
+    with no boundary (a dimension of size 0), and the map exported."""
+    where = tmp_path_factory.mktemp("cf-records")
+    archive, simulation = where / "r.h5", pi.Simulation.from_names()
+    sphere, plate = presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18")
+    found = limits.along_speed(simulation, sphere, plate, np.radians([0.0, 45.0]),
+                               (100.0, 900.0), resolution=50.0)  # fmt: skip
+    limits.archive_limits(archive, "bands", found)
+    thin = presets.plate("2024-T3/1.27")  # perforated at every speed: no boundary at all
+    none = limits.along_speed(simulation, sphere, thin, [0.0], (1500.0, 2000.0), resolution=100.0)
+    assert not none.lines[0].boundaries
+    limits.archive_limits(archive, "none", none)
+    grid = limits.outcome_map(simulation, sphere, plate, (100.0, 1000.0), 4, np.radians([0, 60]))
+    limits.archive_limits(archive, "map", grid)
+    spec = {"preset": "2024-T3/3.18", "failure": "plugging", "samples": 4, "seed": 6,
+            "at": {"obliquity_deg": 30.0},
+            "inputs": {"pstar_mm": {"uniform": {"low": 2.5, "high": 3.5}},
+                       "a_N_m2": {"normal": {"mean": 1.01e9, "sd": 5e7}}}}  # fmt: skip
+    (where / "limits.json").write_text(json.dumps(spec))
+    spec["at"]["speed_m_s"] = 420.0
+    (where / "at.json").write_text(json.dumps(spec))
+    for argv in (["limits.json", "--limits"], ["at.json", "--sobol", "16"],
+                 ["at.json", "--speeds", "600,300", "--obliquities", "0,45"]):  # fmt: skip
+        code, _, err = run_cli(["uncertainty", str(where / argv[0]), *argv[1:],
+                                "--archive", str(archive)])  # fmt: skip
+        assert code == 0, err
+    exported = where / "map.nc"
+    code, _, err = run_cli(["export", str(archive), "--record", "map", "--to", str(exported)])
+    assert code == 0, err
+    stored = sorted((where / "r.h5.d").glob("limits.*.nc"))
+    assert len(stored) == 6  # two limits, a map, and the uncertainty study's three
+    return [*stored, exported]
+
+
 def failed_checks(path: Path, report_file: Path) -> list[tuple[str, str, list[str]]]:
     """(priority, check, messages) of every CF 1.11 check the file does not pass fully."""
     CheckSuite.load_all_available_checkers()
@@ -54,16 +94,55 @@ def failed_checks(path: Path, report_file: Path) -> list[tuple[str, str, list[st
     return failed
 
 
-def test_every_file_passes_every_cf_check(files, tmp_path):
-    for path in files:
+def test_every_file_passes_every_cf_check(files, records, tmp_path):
+    for path in [*files, *records]:
         assert failed_checks(path, tmp_path / "report.json") == [], path.name
 
 
-def test_every_file_says_what_it_is_and_opens_in_xarray_without_a_warning(files):
+def opened(path: Path) -> xarray.Dataset:
+    """The file as xarray opens it, any warning an error."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with xarray.open_dataset(path, engine="h5netcdf") as data:
+            assert data.attrs["Conventions"] == "CF-1.11"
+            assert data.attrs["title"].startswith("plateimpact ")
+            return data.load()
+
+
+def test_every_file_says_what_it_is_and_opens_in_xarray_without_a_warning(files, records):
     for path in files:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            with xarray.open_dataset(path, engine="h5netcdf") as data:
-                assert data.attrs["Conventions"] == "CF-1.11"
-                assert data.attrs["title"].startswith("plateimpact ")
-                assert "s/v" in data.attrs["history"] or "study s" in data.attrs["history"]
+        history = opened(path).attrs["history"]
+        assert "s/v" in history or "study s" in history
+    for path in records:
+        data = opened(path)
+        assert data.attrs["history"].startswith(data.attrs["creation_time"])
+        assert data.attrs["description"].split(";")[0] in data.attrs["title"]
+        for name, variable in data.variables.items():  # units on every number
+            assert variable.dtype.kind in "OU" or "units" in variable.attrs, (path.name, name)
+
+
+def test_a_record_is_labelled_by_its_dimensions(records):
+    """Each record's variables over the axes they truly index: a map's grid over its
+    obliquities and speeds, which are its lines too; limits' lines with their fixed
+    obliquity; the uncertainty study's samples, inputs and points."""
+    named = {path.name.split(".")[1]: opened(path) for path in records[:-1]}
+    kinds = {data.attrs["kind"]: data for data in named.values()}
+    grid = named["map"]
+    assert grid["regime"].dims == ("impact_obliquity", "impact_speed")
+    assert grid["ballistic_limit"].dims == ("impact_obliquity",)
+    assert grid["impact_speed"].attrs["units"] == "m/s" and grid.sizes["impact_speed"] == 4
+    assert named["none"].sizes["boundary"] == 0 and named["none"].sizes["line"] == 1
+    bands = named["bands"]
+    np.testing.assert_array_equal(bands["impact_obliquity"], np.radians([0.0, 45.0]))
+    assert bands["ballistic_limit"].dims == ("line",) and "impact_obliquity" in bands.coords
+    assert set(bands["boundary_line"].values) == {0, 1}
+    sampled = kinds["uncertainty_limits"]
+    assert sampled["ballistic_limit"].dims == ("obliquity", "sample")
+    assert sampled["sampled_critical_penetration"].attrs["units"] == "m"
+    assert list(kinds["uncertainty_indices"]["input_name"].values) == ["pstar_mm", "a_N_m2"]
+    probabilities = kinds["uncertainty_map"]
+    np.testing.assert_array_equal(probabilities["impact_speed"], [600.0, 300.0])  # as asked
+    counts = sum(probabilities[f"{o}_count"] for o in ("ricochet", "embedment", "perforation"))
+    assert (counts == 4).all()  # every sample ends somewhere at every point
+    exported = opened(records[-1])
+    xarray.testing.assert_identical(exported, grid)  # the stored map, attributes and all

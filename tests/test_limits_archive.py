@@ -13,6 +13,7 @@ import attrs
 import h5py
 import numpy as np
 import pytest
+from old_records import to_old_layout
 from test_archive import flip_bytes
 from test_archive_writers import STAGES, debris
 from test_limits import ESTAR, E, P
@@ -175,7 +176,7 @@ def test_damaged_attributes_are_an_archive_error(tmp_path, plugging, damage, mes
 def test_damaged_data_is_an_archive_error(tmp_path, plugging):
     path = tmp_path / "a.h5"
     limits.archive_limits(path, "plugging", plugging)
-    flip_bytes(record_file(path, "plugging"), "boundaries/low")
+    flip_bytes(record_file(path, "plugging"), "boundary_low")
     with pytest.raises(pi.ArchiveError, match="damaged"):
         limits.read_limits(path, "plugging")
 
@@ -190,13 +191,17 @@ CRASHES_HDF5 = b"long_name\x00\x00\x00\x00\x00\x00\x00\x19\x01"
 
 
 def test_a_dataset_attribute_that_crashes_hdf5_is_never_read(tmp_path, plugging):
-    """Found by fuzzing ``show``: a flipped bit in the datatype of a dataset's
-    ``long_name`` (a variable-length kind that does not exist) makes libhdf5 crash when
-    the attribute is read. Reading a record reads no dataset attributes (they are for
-    readers without plateimpact); the data, checksummed, reads back whole. Run in
-    subprocesses, so that a crash fails the test instead of ending pytest."""
+    """Found by fuzzing ``show`` (records in the layout before netCDF): a flipped bit in
+    the datatype of a dataset's ``long_name`` (a variable-length kind that does not
+    exist) makes libhdf5 crash when the attribute is read. Reading a record reads no
+    dataset attributes (they are for readers without plateimpact); the data,
+    checksummed, reads back whole. A netCDF record's object headers carry checksums:
+    there the same flip is damage, said in one line. Run in subprocesses, so that a
+    crash fails the test instead of ending pytest."""
     path = tmp_path / "a.h5"
     limits.archive_limits(path, "plugging", plugging)
+    netcdf = record_file(path, "plugging").read_bytes()
+    to_old_layout(record_file(path, "plugging"))
     data = record_file(path, "plugging").read_bytes()
     assert data.count(CRASHES_HDF5) > 10  # every dataset's long_name, as h5py lays it out
     damaged = data.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05")
@@ -215,6 +220,12 @@ def test_a_dataset_attribute_that_crashes_hdf5_is_never_read(tmp_path, plugging)
     assert done.returncode == 0, done.stderr
     assert float(done.stdout.splitlines()[0]) == plugging.lines[1].ballistic_limit
     assert "limits/plugging: limits along impact speed" in done.stdout
+    assert netcdf.count(CRASHES_HDF5) > 10
+    damaged = netcdf.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05")
+    record_file(path, "plugging").write_bytes(damaged)
+    shown = [sys.executable, "-m", "plateimpact.cli", "show", str(path)]
+    done = subprocess.run(shown, capture_output=True, text=True)
+    assert_one_line(done.returncode, done.stderr, "limits/plugging", "damaged")
 
 
 # -- reviewed without plateimpact ------------------------------------------------------------
@@ -241,20 +252,25 @@ def test_the_file_reads_in_plain_h5py_with_units_everywhere(tmp_path, plugging, 
         assert group.attrs["resolution"] == 10.0 and group.attrs["resolution_units"] == "m/s"
         assert json.loads(group.attrs["plate"])["thickness_mm"] == 3.18
         assert json.loads(group.attrs["model"])["failure"] == "plugging"
-        assert group["lines/fixed"].attrs["units"] == "rad"
-        assert group["boundaries/low"].attrs["units"] == "m/s"
-        assert group["plate/a"].attrs["units"] == "N/m^2" and group["sphere/mass"][0] > 0
+        assert group["impact_obliquity"].attrs["units"] == "rad"  # each line's obliquity
+        np.testing.assert_array_equal(group["impact_obliquity"][()], OBLIQUITIES)
+        assert group["boundary_low"].attrs["units"] == "m/s"
+        assert group["plate_a"].attrs["units"] == "N/m^2" and group["sphere_mass"][0] > 0
         # a reviewer's ballistic limit at 45 deg: the last boundary into perforation (code 7)
-        line, above = group["boundaries/line"][()], group["boundaries/above"][()]
-        low, high = group["boundaries/low"][()], group["boundaries/high"][()]
+        line, above = group["boundary_line"][()], group["regime_above"][()]
+        low, high = group["boundary_low"][()], group["boundary_high"][()]
         last = np.flatnonzero((line == 1) & (above == 7))[-1]
         assert 0.5 * (low[last] + high[last]) == plugging.lines[1].ballistic_limit
-        assert group["lines/ballistic_limit"][1] == plugging.lines[1].ballistic_limit
+        assert group["ballistic_limit"][1] == plugging.lines[1].ballistic_limit
         regimes = json.loads(group.attrs["regimes"])
         assert regimes["3"] == "ricochet after failure" and regimes["7"] == "perforation"
-        grid = f["limits/map/map"]
+        codes = group["regime_above"].attrs
+        flags = dict(zip(codes["flag_values"], codes["flag_meanings"].split(), strict=True))
+        assert flags == {int(k): v.replace(" ", "_") for k, v in regimes.items()}
+        grid = f["limits/map"]
         assert grid["regime"].shape == (3, 10) and grid["exit_speed"].attrs["units"] == "m/s"
         assert grid["exit_obliquity"].attrs["units"] == "rad"
+        np.testing.assert_array_equal(grid["impact_speed"][()], outcome_map.speeds)
 
 
 # -- appended as runs are: atomically, under the lock -----------------------------------------

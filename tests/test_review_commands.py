@@ -178,6 +178,22 @@ def test_export_every_run_of_reproduces_archive_as_netcdf_and_csv(report, tmp_pa
         assert np.array_equal(exported, result.exit_speed, equal_nan=True)
 
 
+def test_export_every_stored_map_of_reproduces_archive_as_netcdf(report, tmp_path):
+    import xarray
+
+    names = pi.limits.stored_limits(report)
+    assert len(names) == 5  # one map per plate
+    for name in names:
+        stored = pi.limits.read_limits(report, name)
+        target = tmp_path / f"{name}.nc"
+        code, out, err = run_cli(["export", str(report), "--record", name, "--to", str(target)])
+        assert code == 0 and err == "" and out == f"wrote limits/{name} to {target}\n"
+        with xarray.open_dataset(target, engine="h5netcdf") as data:
+            assert data["regime"].dims == ("impact_obliquity", "impact_speed")
+            assert np.array_equal(data["regime"].values, stored.regime)
+            assert np.array_equal(data["impact_speed"].values, stored.speeds)
+
+
 def test_limits_and_map_stored_into_reproduces_archive_are_shown_and_compared(
     quick_report, tmp_path
 ):

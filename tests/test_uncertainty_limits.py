@@ -17,11 +17,16 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+import attrs
 import numpy as np
 import pytest
+import xarray
 from closed_forms import ballistic_limit
+from old_records import to_old_layout
+from test_limits_archive import record_file
 from test_output_files import assert_one_line, run_cli
 from test_progress import Pipe, Terminal, ticking
+from test_record_files import exported
 
 import plateimpact as pi
 from plateimpact import presets
@@ -274,6 +279,27 @@ def test_a_two_process_pool_gives_the_same_limits_and_indices(registry):
     assert np.array_equal(perforation.total, perforation_indices(spec_at, registry, 16).total)
 
 
+def bit_for_bit(a: object, b: object) -> bool:
+    """Whether ``a`` and ``b`` hold the same: attrs classes field by field, containers
+    item by item, arrays by dtype, shape and bytes."""
+    if attrs.has(type(a)):
+        fields = attrs.fields(type(a))
+        return type(a) is type(b) and all(
+            bit_for_bit(getattr(a, f.name), getattr(b, f.name)) for f in fields
+        )
+    if isinstance(a, dict):
+        return (
+            isinstance(b, dict) and a.keys() == b.keys() and all(bit_for_bit(a[k], b[k]) for k in a)
+        )
+    if isinstance(a, list | tuple):
+        return isinstance(b, list | tuple) and len(a) == len(b) and all(map(bit_for_bit, a, b))
+    if isinstance(a, np.ndarray):
+        return isinstance(b, np.ndarray) and (a.dtype, a.shape, a.tobytes()) == (
+            b.dtype, b.shape, b.tobytes(),
+        )  # fmt: skip
+    return bool(a == b)
+
+
 def test_each_kind_of_record_reads_back_as_computed(registry, at_30, tmp_path):
     """Sampled limits, indices and a map stored in an archive read back bit for bit."""
     spec = at_30.spec
@@ -304,6 +330,15 @@ def test_each_kind_of_record_reads_back_as_computed(registry, at_30, tmp_path):
     other = read_spec(oblique(60, seed=7), registry)
     with pytest.raises(pi.ArchiveError, match="made for another spec"):
         read_stored(archive, "l", other, registry)
+    # the same records as plateimpact wrote them before records were netCDF: read back
+    # the same, and exported as the same netCDF files
+    before = {name: read_stored(archive, name, spec, registry) for name in ("l", "i", "m")}
+    netcdf = {name: exported(archive.path, name, tmp_path / f"{name}.nc") for name in before}
+    for name, found in before.items():
+        to_old_layout(record_file(archive.path, name))
+        assert bit_for_bit(read_stored(archive, name, spec, registry), found), name
+        old = exported(archive.path, name, tmp_path / f"{name}.old.nc")
+        xarray.testing.assert_identical(old, netcdf[name])
 
 
 def test_a_result_made_by_other_code_is_neither_kept_nor_replaced(registry, at_30, tmp_path):

@@ -1,36 +1,36 @@
 """Limits and outcome maps in study archives (docs/archive.md, "Limits and outcome maps").
 
 A :class:`Limits` or an :class:`OutcomeMap` becomes a storage record (plain attributes
-and datasets with units, storage.records) and back: everything needed to rebuild it
-bit for bit, and to review it in plain h5py (SI values, every dataset with ``units``,
-``long_name`` and ``description``; the regime codes spelt out in an attribute).
+and columns with units, storage.records; the columns: limits.record_columns) and back:
+everything needed to rebuild it bit for bit, and to review it without plateimpact in
+any netCDF tool (SI values, CF ``units``, ``long_name`` and flags on every variable;
+the regime codes also spelt out in an attribute). Records written before records were
+netCDF read back as well.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import json
-import math
 import os
 import socket
 from typing import Any
 
 import numpy as np
 
-from ..base.errors import ArchiveError, ParameterError, PlateImpactError
-from ..base.parameters import Parameter
+from ..base.errors import ArchiveError, ParameterError
 from ..base.untrusted import printable
-from ..model.bodies import MASS, RADIUS, THICKNESS, Plate, Sphere
-from ..model.tables import long_name
+from ..model.bodies import THICKNESS, Plate, Sphere
 from ..provenance.metadata import git_commit, versions
 from ..registry.plugin_registry import PluginRegistry
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import FORMAT as PLATE_FORMAT
-from ..storage.records import Record, RecordColumn
-from .lines import NAMED_LIMITS, OBLIQUITY, SPEED, Boundary, LimitLine
+from ..storage.records import Record, reading, stored
+from .lines import OBLIQUITY, SPEED, Boundary, LimitLine
 from .maps import OutcomeMap
 from .plate_limits import Limits
+from .record_columns import NAMES, OTHER, UNITS, body_data, line_data, record_columns
 from .regimes import REGIMES, Regime
 
 KIND_LIMITS, KIND_MAP = "limits", "outcome_map"
@@ -39,115 +39,24 @@ JSON_ATTRIBUTES = ("plate", "model", "versions", "regimes")
 TEXT_ATTRIBUTES = ("kind", "axis", "axis_units", "tolerance_units", "resolution_units",
                    "git_commit", "host", "creation_time", "description")  # fmt: skip
 NUMBER_ATTRIBUTES = ("tolerance", "resolution", "scenes", "passes", "wall_time_s")
-#: Each axis's SI unit and name.
-UNITS = {SPEED: "m/s", OBLIQUITY: "rad"}
-NAMES = {SPEED: "impact speed", OBLIQUITY: "impact obliquity"}
-_OTHER = {SPEED: OBLIQUITY, OBLIQUITY: SPEED}
-_CODES = "regime code 2 x outcome + plate_failed (see the regimes attribute)"
 
 
-def _axis_columns(limits: Limits) -> dict[str, RecordColumn]:
-    axis, lines = limits.axis, limits.lines
-    unit, other = UNITS[axis], _OTHER[axis]
-    along = NAMES[axis]
-
-    def named(value: float | None) -> float:
-        return math.nan if value is None else value
-
-    columns = {
-        "lines/fixed": RecordColumn(
-            np.array([line.fixed for line in lines]),
-            UNITS[other],
-            NAMES[other],
-            f"the {NAMES[other]} at which each line runs along {along}",
-        ),
-        "lines/start": RecordColumn(
-            np.array([line.start for line in lines]),
-            unit,
-            f"start {along}",
-            "where each line starts",
-        ),
-        "lines/end": RecordColumn(
-            np.array([line.end for line in lines]), unit, f"end {along}", "where each line ends"
-        ),
-        "lines/first": RecordColumn(
-            np.array([line.first.code for line in lines], dtype=np.int8),
-            "1",
-            "first regime",
-            f"each line's regime at its start: {_CODES}",
-        ),
-    }
-    for declared in NAMED_LIMITS[axis]:
-        values = [named(getattr(line, declared.name)) for line in lines]
-        columns[f"lines/{declared.name}"] = RecordColumn(
-            np.array(values),
-            declared.unit,
-            long_name(declared),
-            f"the {declared.description} (NaN: none on the line)",
-        )
-    found = [(i, b) for i, line in enumerate(lines) for b in line.boundaries]
-    at = np.array([b.at for _, b in found], dtype=float)
-    columns |= {
-        "boundaries/line": RecordColumn(
-            np.array([i for i, _ in found], dtype=np.int32),
-            "1",
-            "line",
-            "index of the boundary's line in lines/",
-        ),
-        "boundaries/low": RecordColumn(
-            np.array([b.low for _, b in found], dtype=float),
-            unit,
-            f"{along} below",
-            "a scene here ends in the regime below",
-        ),
-        "boundaries/high": RecordColumn(
-            np.array([b.high for _, b in found], dtype=float),
-            unit,
-            f"{along} above",
-            "a scene here ends in the regime above",
-        ),
-        "boundaries/at": RecordColumn(
-            at, unit, f"boundary {along}", "midpoint of low and high, within half the tolerance"
-        ),
-        "boundaries/below": RecordColumn(
-            np.array([b.below.code for _, b in found], dtype=np.int8), "1", "regime below", _CODES
-        ),
-        "boundaries/above": RecordColumn(
-            np.array([b.above.code for _, b in found], dtype=np.int8), "1", "regime above", _CODES
-        ),
-    }
-    return columns
-
-
-def _body_columns(
-    sphere: Sphere, plate: Plate, registry: PluginRegistry
-) -> dict[str, RecordColumn]:
-    declared = registry.plate_constants
-    columns = {}
-    for where, parameter, value in [
-        ("sphere/radius", RADIUS, sphere.radius),
-        ("sphere/mass", MASS, sphere.mass),
-        ("plate/thickness", THICKNESS, plate.thickness),
-        *((f"plate/{name}", declared.get(name), value) for name, value in plate.constants),
-    ]:
-        parameter = parameter or Parameter(where, "plate constant (no plug-in declares it)")
-        columns[where] = RecordColumn(
-            np.array([value]), parameter.unit or "1", parameter.name, parameter.description
-        )
-    return columns
+def _title(found: Limits | OutcomeMap) -> str:
+    """What ``found`` is: ``limits along impact speed of 2024-T3 3.18 mm``."""
+    limits = found.limits if isinstance(found, OutcomeMap) else found
+    what = "outcome map" if isinstance(found, OutcomeMap) else f"limits along {NAMES[limits.axis]}"
+    return f"{what} of {limits.plate.material} {limits.plate.thickness / THICKNESS.scale:g} mm"
 
 
 def to_record(found: Limits | OutcomeMap) -> Record:
-    """The record of ``found`` (plain attributes and datasets, SI)."""
+    """The record of ``found`` (plain attributes and columns, SI)."""
     limits = found.limits if isinstance(found, OutcomeMap) else found
     unit = UNITS[limits.axis]
     kind = KIND_MAP if isinstance(found, OutcomeMap) else KIND_LIMITS
-    what = "outcome map" if kind == KIND_MAP else f"limits along {NAMES[limits.axis]}"
     plate = {"format": PLATE_FORMAT, **limits.plate_record()}
     attributes: dict[str, object] = {
         "kind": kind,
-        "description": f"{what} of {plate['material']} {plate[THICKNESS.key]:g} mm; "
-        "see docs/archive.md",
+        "description": f"{_title(found)}; see docs/archive.md",
         "axis": limits.axis,
         "axis_units": unit,
         "tolerance": limits.tolerance,
@@ -167,28 +76,7 @@ def to_record(found: Limits | OutcomeMap) -> Record:
     }
     if limits.plugins is not None:  # the code that found them (docs/archive.md, Provenance)
         attributes["plugins"] = json.dumps(limits.plugins, sort_keys=True)
-    assert limits.registry is not None  # plate_record refused it otherwise
-    columns = _body_columns(limits.sphere, limits.plate, limits.registry) | _axis_columns(limits)
-    if isinstance(found, OutcomeMap):
-        columns |= {
-            "map/speeds": RecordColumn(found.speeds, "m/s", "impact speed", "the grid's columns"),
-            "map/obliquities": RecordColumn(
-                found.obliquities, "rad", "impact obliquity", "the grid's rows"
-            ),
-            "map/regime": RecordColumn(
-                found.regime, "1", "regime", f"rows: obliquities, columns: speeds; {_CODES}"
-            ),
-            "map/exit_speed": RecordColumn(
-                found.exit_speed,
-                "m/s",
-                "exit speed",
-                "rows: obliquities, columns: speeds (0 at rest)",
-            ),
-            "map/exit_obliquity": RecordColumn(
-                found.exit_obliquity, "rad", "exit obliquity", "rows: obliquities, columns: speeds"
-            ),
-        }
-    return Record(attributes, columns)
+    return Record(attributes, record_columns(found), _title(found))
 
 
 def _plugins(attributes: dict[str, object], what: str) -> dict[str, Any] | None:
@@ -213,29 +101,24 @@ def from_record(
     not one; ArchiveError naming ``what`` for an attribute of the wrong type: they come
     from a file, maybe someone else's); ``registry`` describes their plate when they
     are written again (Limits.plate_record)."""
-    attributes, columns = record.attributes, record.columns
-
-    def data(where: str) -> np.ndarray:
-        return columns[where].data
-
+    attributes = record.attributes
     kind, axis = typed.text(attributes, "kind", what), typed.text(attributes, "axis", what)
     if kind not in (KIND_LIMITS, KIND_MAP) or axis not in UNITS:
         raise ValueError(f"kind {kind!r} along {axis!r} is not one this plateimpact reads")
-    sphere = Sphere(float(data("sphere/radius")[0]), float(data("sphere/mass")[0]))
-    constants = {
-        where.split("/", 1)[1]: float(column.data[0])
-        for where, column in columns.items()
-        if where.startswith("plate/") and where != "plate/thickness"
-    }
+    radius, mass, thickness, constants = body_data(record)
     material = typed.json_value(attributes, "plate", what, dict).get("material")
     if not isinstance(material, str):
         raise ArchiveError(f"{what}: attribute plate names no material")
-    plate = Plate(material, float(data("plate/thickness")[0]), constants)
-    index, low, high = data("boundaries/line"), data("boundaries/low"), data("boundaries/high")
-    below, above = data("boundaries/below"), data("boundaries/above")
+    plate = Plate(material, thickness, constants)
+    index, low, high = (line_data(record, f"boundary_{k}") for k in ("line", "low", "high"))
+    below, above = line_data(record, "regime_below"), line_data(record, "regime_above")
+    fixed = stored(record, OTHER[axis], "lines/fixed")  # a map's: the rows of its grid
+    starts = line_data(record, "line_start")
+    if fixed.shape != starts.shape:
+        raise ValueError(f"{fixed.size} fixed coordinates for {starts.size} lines")
     lines = []
-    for i, (fixed, start, end, first) in enumerate(
-        zip(data("lines/fixed"), data("lines/start"), data("lines/end"), data("lines/first"),
+    for i, (start, end, first) in enumerate(
+        zip(starts, line_data(record, "line_end"), line_data(record, "first_regime"),
             strict=True)
     ):  # fmt: skip
         mine = np.flatnonzero(index == i)
@@ -244,14 +127,14 @@ def from_record(
                      Regime.of_code(above[k]))
             for k in mine
         )  # fmt: skip
-        lines.append(LimitLine(axis, float(fixed), float(start), float(end), boundaries,
+        lines.append(LimitLine(axis, float(fixed[i]), float(start), float(end), boundaries,
                                Regime.of_code(first)))  # fmt: skip
     limits = Limits(
         axis,
         tuple(lines),
         _number(attributes, "tolerance"),
         _number(attributes, "resolution"),
-        sphere,
+        Sphere(radius, mass),
         plate,
         typed.json_value(attributes, "model", what, dict),
         int(_number(attributes, "scenes")),
@@ -263,11 +146,11 @@ def from_record(
     if kind == KIND_LIMITS:
         return limits
     return OutcomeMap(
-        data("map/speeds"),
-        data("map/obliquities"),
-        data("map/regime"),
-        data("map/exit_speed"),
-        data("map/exit_obliquity"),
+        stored(record, SPEED, "map/speeds"),
+        stored(record, OBLIQUITY, "map/obliquities"),
+        stored(record, "regime", "map/regime"),
+        stored(record, "exit_speed", "map/exit_speed"),
+        stored(record, "exit_obliquity", "map/exit_obliquity"),
         limits,
     )
 
@@ -314,15 +197,25 @@ def read_limits(
             f"{what} holds {printable(kind, 40)}, not limits or an outcome map "
             "(plateimpact show describes it)"
         )
-    try:
+    return _read_back(record, what, registry)
+
+
+def _read_back(record: Record, what: str, registry: PluginRegistry | None) -> Limits | OutcomeMap:
+    """:func:`from_record`, every failure an ArchiveError naming ``what`` (one line)."""
+    with reading(what):
         return from_record(record, what, registry)
-    except ArchiveError:
-        raise
-    except (KeyError, ValueError, TypeError, IndexError, AttributeError, PlateImpactError) as exc:
-        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
-        raise ArchiveError(
-            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
-        ) from None
+
+
+def cf_record(record: Record, what: str, registry: PluginRegistry) -> Record:
+    """The stored limits or map ``record`` (either layout), as this plateimpact writes
+    it: its attributes as stored, its columns over their dimensions (for export)."""
+    with reading(what):  # a map whose lines are not its rows, too
+        found = from_record(record, what, registry)
+        return Record(record.attributes, record_columns(found), _title(found))
+
+
+#: Each kind's :func:`cf_record`, for ``plateimpact export --record``.
+CF_RECORDS = {KIND_LIMITS: cf_record, KIND_MAP: cf_record}
 
 
 def stored_limits(archive: Archive | str | os.PathLike[str]) -> list[str]:

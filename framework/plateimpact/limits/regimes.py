@@ -53,6 +53,8 @@ REGIMES = (
     Regime(Outcome.EMBEDMENT, True),
     Regime(Outcome.PERFORATION, True),
 )
+#: The regime codes as CF flags: ``flag_values`` and blank-separated ``flag_meanings``.
+REGIME_FLAGS = ([r.code for r in REGIMES], " ".join(r.label.replace(" ", "_") for r in REGIMES))
 
 
 def regime_codes(result: BatchResult) -> np.ndarray:

@@ -1,5 +1,6 @@
-"""Runs for review outside plateimpact: a grid study as an xarray cube, a run as a
-netCDF-4 file or a tidy CSV table (docs/archive.md, "Reviewing archives").
+"""Runs and records for review outside plateimpact: a grid study as an xarray cube, a
+run as a netCDF-4 file or a tidy CSV table, a stored record (limits, a map, an
+uncertainty study's result) as a netCDF-4 file (docs/archive.md, "Reviewing archives").
 
 xarray is imported only when a cube is asked for (model.tables).
 """
@@ -8,22 +9,25 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
-from ..base.errors import ParameterError
+from ..base.errors import ArchiveError, ParameterError
 from ..base.parameters import Parameter
+from ..base.untrusted import printable
 from ..model.fields import CORE_COLUMNS
 from ..model.results import RESULT_FIELDS, BatchResult, Outcome
 from ..model.tables import PLATE, VARIANT, Column, LabelledTable, column_declaration
 from ..registry.plugin_registry import PluginRegistry
+from . import stored_attributes as typed
 from .append import StudyDefinition
 from .archive import Archive
 from .data_files import encoded
 from .netcdf import write_run_file
+from .records import LIMITS, Record, reading, write_record_file
 
 if TYPE_CHECKING:
     import xarray
@@ -114,6 +118,30 @@ def netcdf_bytes(archive: Archive, run: str, *, registry: PluginRegistry) -> byt
     no disk: no temporary directory that could be full), as bytes for an atomic
     writer."""
     return encoded(lambda handle: write_run_netcdf(archive, run, handle, registry=registry))
+
+
+def record_netcdf_bytes(
+    archive: Archive,
+    name: str,
+    convert: Mapping[str, Callable[[Record, str, PluginRegistry], Record]],
+    *,
+    registry: PluginRegistry,
+) -> bytes:
+    """The stored record ``name`` (``NAME`` or ``limits/NAME``) as one netCDF-4 file, made
+    in memory: laid out as the archive writes a record now, whatever layout it was
+    stored in (``convert[kind](record, what, registry)`` gives it again from what was
+    read; its attributes as stored). UnknownNameError lists the stored names."""
+    record = archive.record(name)
+    what = f"archive {archive.path}: {LIMITS}/{printable(name.removeprefix(f'{LIMITS}/'))}"
+    kind = typed.text(record.attributes, "kind", what)
+    if kind not in convert:
+        raise ArchiveError(
+            f"{what} is of kind {printable(kind, 40)}, which this plateimpact does not "
+            f"export (it exports {', '.join(convert)})"
+        )
+    with reading(what):  # columns that do not agree (a damaged record) are refused too
+        again = convert[kind](record, what, registry)
+        return encoded(lambda handle: write_record_file(handle, again))
 
 
 def table_header(archive: Archive, run: str, *, registry: PluginRegistry) -> list[str]:

@@ -14,6 +14,7 @@ attributes are sealed by their SHA-256 as in format 1.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
 from typing import Any, BinaryIO
@@ -32,15 +33,24 @@ from .hdf5 import digest
 SAMPLE, POINT = "trajectory_sample", "crater_point"
 
 
-def _chunk(size: int) -> tuple[int]:
-    return (int(min(max(size, 1), 1 << 16)),)
+#: CF flags: the codes (``flag_values``) and their blank-separated names.
+Flags = tuple[Sequence[int], str]
 
 
-def _variable(
-    f: Any, name: str, dims: tuple[str, ...], data: np.ndarray, declared: Parameter
-) -> Any:
-    """A checksummed variable with CF ``units``, ``long_name`` and the declared
-    ``description`` (and flags, for integer codes)."""
+def _chunks(shape: tuple[int, ...]) -> tuple[int, ...]:
+    """Whole rows up to 2**16 values a chunk (a grid's rows whole)."""
+    inner = math.prod(max(n, 1) for n in shape[1:])
+    rows = max(1, (1 << 16) // inner)
+    return (int(min(max(shape[0], 1), rows)), *(max(n, 1) for n in shape[1:]))
+
+
+def cf_variable(
+    f: Any, name: str, dims: tuple[str, ...], data: np.ndarray, *, units: str, long_name: str,
+    description: str, flags: Flags | None = None,
+) -> Any:  # fmt: skip
+    """A variable over ``dims`` (at least one: HDF5 checksums chunked data only), numbers
+    chunked and fletcher32-checksummed with CF ``units`` ("1": dimensionless), text
+    without; ``long_name``, ``description`` and, for integer codes, CF ``flags``."""
     data = np.asarray(data)
     if data.dtype == bool:
         data = data.astype(np.int8)
@@ -48,17 +58,26 @@ def _variable(
         variable = f.create_variable(name, dims, h5py.string_dtype(), data=data.astype(object))
     else:
         variable = f.create_variable(
-            name, dims, data.dtype, data=data, chunks=_chunk(data.size), fletcher32=True
+            name, dims, data.dtype, data=data, chunks=_chunks(data.shape), fletcher32=True
         )
-    if declared.name in FLAGS:
-        values, meanings = FLAGS[declared.name]
-        variable.attrs["flag_values"] = np.array(values, dtype=data.dtype)
-        variable.attrs["flag_meanings"] = meanings
+    if flags is not None:
+        variable.attrs["flag_values"] = np.array(flags[0], dtype=data.dtype)
+        variable.attrs["flag_meanings"] = flags[1]
     if data.dtype.kind not in "OUS":
-        variable.attrs["units"] = declared.unit or "1"
-    variable.attrs["long_name"] = long_name(declared)
-    variable.attrs["description"] = declared.description
+        variable.attrs["units"] = units or "1"
+    variable.attrs["long_name"] = long_name
+    variable.attrs["description"] = description
     return variable
+
+
+def _variable(
+    f: Any, name: str, dims: tuple[str, ...], data: np.ndarray, declared: Parameter
+) -> Any:
+    """:func:`cf_variable` of a declared quantity (its SI unit, its flags if coded)."""
+    return cf_variable(
+        f, name, dims, data, units=declared.unit, long_name=long_name(declared),
+        description=declared.description, flags=FLAGS.get(declared.name),
+    )  # fmt: skip
 
 
 def write_scenes(
@@ -157,9 +176,9 @@ def write_scenes_file(
 
 def described(what: str, attributes: Mapping[str, object]) -> dict[str, str]:
     """A data file's ``Conventions``, ``title`` and ``history`` (CF §2.6.2): what it holds
-    and, for a run, when it started (a study's scenes file carries no time, so that
-    writing the same study twice gives the same file)."""
-    when = attributes.get("start_time")
+    and, for a run, when it started (a stored record: when it was made; a study's scenes
+    file carries no time, so that writing the same study twice gives the same file)."""
+    when = attributes.get("start_time", attributes.get("creation_time"))
     return {
         "Conventions": CONVENTIONS,
         "title": f"plateimpact {what}: rigid spheres striking plates (model of NWC TP 5844)",

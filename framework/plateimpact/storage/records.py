@@ -2,16 +2,25 @@
 (docs/archive.md, "Limits and outcome maps").
 
 A record is plain data, so that storage needs nothing of what it holds: sealed
-attributes (strings and numbers) and datasets, each with its SI ``units``, a
-``long_name`` and a ``description``. Records live under the top-level group ``/limits``,
-one entry each, ``/limits/NAME`` (format 2: a link to the record's own data file, as
-runs are); a name already there gets ``.2``, ``.3``, ..., and the name it took is
-returned and printed. The study name ``limits`` is therefore reserved.
+attributes (strings and numbers) and columns, each with its SI ``units``, a
+``long_name``, a ``description`` and the named dimensions it runs over. Records live
+under the top-level group ``/limits``, one entry each, ``/limits/NAME`` (format 2: a
+link to the record's own data file, as runs are); a name already there gets ``.2``,
+``.3``, ..., and the name it took is returned and printed. The study name ``limits`` is
+therefore reserved.
+
+A record's data file is netCDF-4 and CF-1.11 (storage.netcdf): one flat group, every
+column a variable over its dimensions, each dimension with its coordinate variable (so
+the file holds no dataset but the columns), the attributes global and sealed, with
+``Conventions``, ``title`` and ``history``. Records written before that are HDF5 groups
+whose columns are datasets at paths (``lines/fixed``) without dimensions; they are read
+as they are (:func:`stored` finds a column under either name).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import BinaryIO
 
@@ -19,11 +28,12 @@ import attrs
 import h5py
 import numpy as np
 
-from ..base.errors import ArchiveError, ParameterError
+from ..base.errors import ArchiveError, ParameterError, PlateImpactError
 from ..base.untrusted import printable
 from .append import append_with
 from .data_files import DataFiles
-from .hdf5 import seal, write_dataset
+from .hdf5 import seal
+from .netcdf import Flags, cf_variable, described, seal_file
 
 #: The top-level group of the stored records; a study may not take its name.
 LIMITS = "limits"
@@ -34,22 +44,48 @@ RESERVED_NAMES = ("runs", "scenes")
 
 @attrs.frozen(eq=False)
 class RecordColumn:
-    """One dataset of a record: ``data`` [``units``, SI; "1" for none]. Read back, a
-    column has its data only (storage.records.read_record)."""
+    """One variable of a record: ``data`` [``units``, SI; "1" for none] over the named
+    ``dimensions`` (one per axis of ``data``), with CF ``flags`` (codes and their names)
+    for integer codes and the CF ``coordinates`` (auxiliary coordinates' names, blank
+    separated) that label it. Read back, a column has its data only
+    (storage.records.read_record)."""
 
     data: np.ndarray
     units: str
     long_name: str
     description: str = ""
+    dimensions: tuple[str, ...] = ()
+    flags: Flags | None = None
+    coordinates: str = ""
 
 
 @attrs.frozen(eq=False)
 class Record:
     """What a record stores: ``attributes`` (str, int, float or bool; sealed) and
-    ``columns`` by their path inside the record's group (``lines/fixed``)."""
+    ``columns`` by their variable's name (in a record read back from before records
+    were netCDF, by their path: ``lines/fixed``); ``what``: what it holds, for the
+    file's ``title`` and ``history`` (read back, the ``title`` attribute says it)."""
 
     attributes: dict[str, object]
     columns: dict[str, RecordColumn]
+    what: str = ""
+
+
+def index_column(dimension: str, size: int, what: str) -> RecordColumn:
+    """The coordinate variable of ``dimension``: each ``what``'s index, from 0."""
+    return RecordColumn(
+        np.arange(size, dtype=np.int64), "1", f"{dimension} index",
+        f"the {what}'s index, from 0", (dimension,),
+    )  # fmt: skip
+
+
+def stored(record: Record, name: str, legacy: str) -> np.ndarray:
+    """The data of the column ``name``, or of ``legacy`` (its path in a record written
+    before records were netCDF); KeyError if the record has neither."""
+    column = record.columns.get(name, record.columns.get(legacy))
+    if column is None:
+        raise KeyError(name)
+    return column.data
 
 
 def is_container(f: h5py.File, name: str) -> bool:
@@ -137,19 +173,61 @@ def write_record(
     return stored
 
 
+@contextlib.contextmanager
+def reading(what: str) -> Iterator[None]:
+    """Turn what reading a record's values may raise (a record comes from a file, maybe
+    someone else's: a column missing, of the wrong shape or type) into one
+    ArchiveError naming ``what``."""
+    try:
+        yield
+    except ArchiveError:
+        raise
+    except (KeyError, ValueError, TypeError, IndexError, AttributeError, PlateImpactError) as exc:
+        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
+        raise ArchiveError(
+            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
+        ) from None
+
+
+def _dimension_sizes(columns: Mapping[str, RecordColumn]) -> dict[str, int]:
+    """Each dimension the ``columns`` run over and its size; ValueError unless every
+    column names one dimension per axis (at least one: checksums need chunks), each
+    dimension has one size and a coordinate variable (a column of its name over it)."""
+    sizes: dict[str, int] = {}
+    for name, column in columns.items():
+        shape = np.shape(column.data)
+        if not column.dimensions or len(column.dimensions) != len(shape):
+            raise ValueError(f"column {name}: {len(shape)} axes, dimensions {column.dimensions}")
+        for dimension, size in zip(column.dimensions, shape, strict=True):
+            if sizes.setdefault(dimension, size) != size:
+                raise ValueError(f"column {name}: {dimension} has size {sizes[dimension]}")
+    for dimension in sizes:
+        if dimension not in columns or columns[dimension].dimensions != (dimension,):
+            raise ValueError(f"dimension {dimension} has no coordinate variable")
+    return sizes
+
+
 def write_record_file(where: BinaryIO, record: Record) -> None:
-    """The record's own HDF5 file (into a file object: archives write in memory): sealed
-    attributes at its root, then its datasets."""
-    with h5py.File(where, "w") as group:
-        for key, value in record.attributes.items():
-            group.attrs[key] = value
-        seal(group)
-        for at, column in record.columns.items():
-            parent, _, leaf = at.rpartition("/")
-            target = group.require_group(parent) if parent else group
-            write_dataset(
-                target, leaf, column.data, column.units, column.description, column.long_name
-            )
+    """The record's own netCDF-4 file (into a file object: archives write in memory):
+    its dimensions, coordinate variables first, then the other columns, and the sealed
+    global attributes with ``Conventions``, ``title`` and ``history``."""
+    import h5netcdf  # noqa: PLC0415 (only archives need it)
+
+    sizes = _dimension_sizes(record.columns)
+    first = sorted(record.columns, key=lambda name: name not in sizes)
+    with h5netcdf.File(where, "w") as f:
+        f.dimensions.update(sizes)
+        for name in first:
+            column = record.columns[name]
+            variable = cf_variable(
+                f, name, column.dimensions, column.data, units=column.units,
+                long_name=column.long_name, description=column.description,
+                flags=column.flags,
+            )  # fmt: skip
+            if column.coordinates:
+                variable.attrs["coordinates"] = column.coordinates
+        what = record.what or f"stored {record.attributes.get('kind', 'record')}"
+        seal_file(f, {**described(what, record.attributes), **record.attributes})
 
 
 def append_record(

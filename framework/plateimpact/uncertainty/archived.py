@@ -20,7 +20,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from ..base.errors import ArchiveError, PlateImpactError
+from ..base.errors import ArchiveError
 from ..base.untrusted import printable
 from ..provenance.code import limits_record, plugins_record
 from ..provenance.metadata import git_commit, versions
@@ -29,12 +29,23 @@ from ..run.simulation import Simulation
 from ..storage import stored_attributes as typed
 from ..storage.archive import Archive
 from ..storage.plate_file import plate_to_dict
-from ..storage.records import LIMITS, Record, RecordColumn
+from ..storage.records import LIMITS, Record, RecordColumn, reading
 from ..study.reruns import StaleRunError, check_code
 from .curves import OutcomeGrid
 from .inputs import input_table
 from .limits import SampledLimits
 from .propagation import OUTCOMES, sample_inputs, spec_digest
+from .record_columns import (
+    INDEX_KEYS,
+    count_data,
+    grid_data,
+    index_data,
+    indices_columns,
+    limits_columns,
+    limits_data,
+    map_columns,
+    samples_of,
+)
 from .sensitivity import SobolIndices
 from .spec import UncertaintySpec
 
@@ -62,6 +73,25 @@ def code_record(simulation: Simulation, searched: bool) -> dict[str, Any]:
     return {**plugins_record(simulation), **({"limits": limits_record()} if searched else {})}
 
 
+def _title(kind: str, plate: Mapping[str, Any]) -> str:
+    """What a record is: ``Sobol' indices of an uncertainty study of 2024-T3 3.18 mm``."""
+    return (
+        f"{WHAT[kind]} of an uncertainty study of {plate.get('material')} "
+        f"{plate.get('thickness_mm')} mm"
+    )
+
+
+def _plate(attributes: Mapping[str, object]) -> dict[str, Any]:
+    """The plate object of attributes :func:`_attributes` made."""
+    found: dict[str, Any] = json.loads(str(attributes["plate"]))
+    return found
+
+
+def _sampling(spec: Mapping[str, Any]) -> str:
+    """How a spec (as described) draws its samples: ``sobol, seed 7``."""
+    return f"{spec.get('method')}, seed {spec.get('seed')}"
+
+
 def _attributes(
     kind: str, spec: UncertaintySpec, simulation: Simulation, searched: bool,
     settings: Mapping[str, Any],
@@ -69,8 +99,7 @@ def _attributes(
     plate = plate_to_dict(spec.plate, registry=simulation.registry)
     return {
         "kind": kind,
-        "description": f"{WHAT[kind]} of an uncertainty study of {spec.plate.material} "
-        f"{plate['thickness_mm']:g} mm; see docs/uncertainty.md",
+        "description": f"{_title(kind, plate)}; see docs/uncertainty.md",
         "spec": json.dumps(spec.describe(), sort_keys=True),
         "spec_sha256": spec_digest(spec),
         "settings": json.dumps(dict(settings), sort_keys=True),
@@ -81,22 +110,6 @@ def _attributes(
         "git_commit": git_commit(),
         "host": socket.gethostname(),
         "creation_time": dt.datetime.now(dt.UTC).isoformat(),
-    }
-
-
-def _samples(
-    spec: UncertaintySpec, inputs: Mapping[str, np.ndarray], registry: PluginRegistry
-) -> dict[str, RecordColumn]:
-    """The sampled inputs, SI, by their scene column (long name: the spec's name)."""
-    table = input_table(registry)
-    return {
-        f"samples/{table[name].column}": RecordColumn(
-            values * table[name].parameter.scale,
-            table[name].parameter.unit or "1",
-            name,
-            f"the sampled {name} of each sample ({spec.method}, seed {spec.seed})",
-        )  # fmt: skip
-        for name, values in inputs.items()
     }
 
 
@@ -112,32 +125,23 @@ def limits_to_record(
         "resolution": first.resolution, "resolution_units": "m/s",
         "scenes": first.scenes, "passes": first.passes,
     }  # fmt: skip
-    rows = "rows: obliquities, columns: samples"
-    columns = {
-        "obliquities": RecordColumn(
-            np.array([f.obliquity for f in found]), "rad", "impact obliquity", "the rows"
-        ),
-        "speed_range": RecordColumn(
-            np.array(first.speeds), "m/s", "impact speed", "the range searched (start, end)"
-        ),
-        "ballistic_limit": RecordColumn(
-            np.array([f.ballistic for f in found]), "m/s", "ballistic limit",
-            f"{rows}; -inf: perforates at every speed of the range, +inf: at none",
-        ),
-        "ricochet_limit": RecordColumn(
-            np.array([f.ricochet for f in found]), "m/s", "ricochet limit",
-            f"{rows}; -inf: ricochets at no speed of the range, +inf: at every one",
-        ),
-        "perforation_gaps": RecordColumn(
-            np.array([f.perforation_gaps for f in found]), "1", "perforation gaps",
-            "samples with a perforation band below a non-perforating one, per obliquity",
-        ),
-        "ricochet_gaps": RecordColumn(
-            np.array([f.ricochet_gaps for f in found]), "1", "ricochet gaps",
-            "samples with a ricochet band above a non-ricochet one, per obliquity",
-        ),
-    }  # fmt: skip
-    return Record(attributes, columns | _samples(first.spec, first.inputs, simulation.registry))
+    table = input_table(simulation.registry)
+    samples = {
+        table[name].column: values * table[name].parameter.scale
+        for name, values in first.inputs.items()
+    }
+    limits = {
+        "ballistic_limit": np.array([f.ballistic for f in found]),
+        "ricochet_limit": np.array([f.ricochet for f in found]),
+        "perforation_gaps": np.array([f.perforation_gaps for f in found]),
+        "ricochet_gaps": np.array([f.ricochet_gaps for f in found]),
+        "speed_range": np.array(first.speeds),
+    }
+    columns = limits_columns(
+        np.array([f.obliquity for f in found]), limits, samples, simulation.registry,
+        _sampling(first.spec.describe()),
+    )  # fmt: skip
+    return Record(attributes, columns, _title(KIND_LIMITS, _plate(attributes)))
 
 
 def limits_from_record(
@@ -145,16 +149,16 @@ def limits_from_record(
 ) -> tuple[SampledLimits, ...]:
     """The sampled limits ``record`` holds, of ``spec`` (whose samples are drawn again,
     the same bits, and checked against the stored ones)."""
-    data = {where: column.data for where, column in record.columns.items()}
     attributes = record.attributes
     inputs = sample_inputs(spec)
     table = input_table(registry)
+    samples = samples_of(record)
     for name, values in inputs.items():
-        stored = data[f"samples/{table[name].column}"]
-        if not np.array_equal(stored, values * table[name].parameter.scale):
+        if not np.array_equal(samples[table[name].column], values * table[name].parameter.scale):
             raise ArchiveError(f"{what}: its samples of {name} are not the spec's")
-    obliquities = data["obliquities"]
+    obliquities = grid_data(record, "impact_obliquity")
     shape = (obliquities.size, spec.samples)
+    data = limits_data(record)
     ballistic, ricochet = data["ballistic_limit"], data["ricochet_limit"]
     if (
         ballistic.shape != shape
@@ -191,21 +195,19 @@ def indices_to_record(
     their bootstrap intervals (dimensionless)."""
     searched = "ballistic_limit" in found
     attributes = _attributes(KIND_INDICES, spec, simulation, searched, settings)
-    columns = {}
     for quantity, indices in found.items():
         attributes[f"{quantity}_inputs"] = json.dumps(list(indices.names))
         attributes[f"{quantity}_evaluations"] = indices.evaluations
         attributes[f"{quantity}_confidence"] = indices.confidence
-        for key, long_name in (("first", "first-order index"), ("total", "total index")):
-            columns[f"{quantity}/{key}"] = RecordColumn(
-                getattr(indices, key), "1", long_name, f"of {quantity}, one per input"
-            )
-            columns[f"{quantity}/{key}_halfwidth"] = RecordColumn(
-                getattr(indices, f"{key}_halfwidth"), "1", f"{long_name}'s half-width",
-                f"of its bootstrap interval at {quantity}_confidence",
-            )  # fmt: skip
     attributes["quantities"] = json.dumps(list(found))
-    return Record(attributes, columns)
+    names = {indices.names for indices in found.values()}
+    if len(names) != 1:
+        raise ValueError(f"the quantities' indices are of different inputs: {names}")
+    columns = indices_columns(
+        names.pop(),
+        {q: {key: getattr(indices, key) for key in INDEX_KEYS} for q, indices in found.items()},
+    )
+    return Record(attributes, columns, _title(KIND_INDICES, _plate(attributes)))
 
 
 def indices_from_record(record: Record, what: str) -> dict[str, SobolIndices]:
@@ -217,7 +219,7 @@ def indices_from_record(record: Record, what: str) -> dict[str, SobolIndices]:
             str(n) for n in typed.json_value(attributes, f"{quantity}_inputs", what, list)
         )
         first, first_half, total, total_half = (
-            record.columns[f"{quantity}/{key}"].data
+            index_data(record, quantity, key)
             for key in ("first", "first_halfwidth", "total", "total_halfwidth")
         )
         if any(a.shape != (len(names),) for a in (first, first_half, total, total_half)):
@@ -238,29 +240,18 @@ def map_to_record(
     """How many samples end in each outcome at each (speed, obliquity) point."""
     attributes = _attributes(KIND_MAP, found.spec, simulation, False, settings)
     attributes["samples"] = found.samples
-    grid = "rows: speeds, columns: obliquities"
-    columns = {
-        "speeds": RecordColumn(found.speeds_m_s, "m/s", "impact speed", "the rows"),
-        "obliquities": RecordColumn(
-            np.radians(found.obliquities_deg), "rad", "impact obliquity", "the columns"
-        ),
-        **{
-            f"counts/{name}": RecordColumn(
-                count, "1", f"{name} count", f"{grid}; samples ending in {name} (of samples)"
-            )
-            for name, count in found.counts.items()
-        },
-    }
-    return Record(attributes, columns)
+    columns = map_columns(found.speeds_m_s, np.radians(found.obliquities_deg), found.counts)
+    return Record(attributes, columns, _title(KIND_MAP, _plate(attributes)))
 
 
 def map_from_record(record: Record, spec: UncertaintySpec, what: str) -> OutcomeGrid:
     """The probability map ``record`` holds, of ``spec``."""
-    data = {where: column.data for where, column in record.columns.items()}
-    speeds = data["speeds"]
+    speeds = grid_data(record, "impact_speed")
     # degrees as typed (30, not 29.999999999999996 after the round trip through rad)
-    degrees = np.array([float(f"{math.degrees(x):.12g}") for x in data["obliquities"]])
-    counts = {name: data[f"counts/{name}"] for name in OUTCOMES}
+    degrees = np.array(
+        [float(f"{math.degrees(x):.12g}") for x in grid_data(record, "impact_obliquity")]
+    )
+    counts = {name: count_data(record, name) for name in OUTCOMES}
     samples = int(typed.number(record.attributes, "samples", what))
     if any(c.shape != (speeds.size, degrees.size) for c in counts.values()) or np.any(
         sum(counts.values()) != samples
@@ -274,17 +265,50 @@ def _read_back(
 ) -> Found:
     """``read(record, what)`` of a record made for ``spec``; ArchiveError, one line, for
     a record of another spec or one that is damaged (it comes from a file)."""
-    try:
+    with reading(what):
         if typed.text(record.attributes, "spec_sha256", what) != spec_digest(spec):
             raise ArchiveError(f"{what} was made for another spec")
         return read(record, what)
-    except ArchiveError:
-        raise
-    except (KeyError, ValueError, TypeError, IndexError, PlateImpactError) as exc:
-        reason = printable(str(exc).splitlines()[0] if str(exc) else "missing", 160)
-        raise ArchiveError(
-            f"{what} cannot be read back ({type(exc).__name__}: {reason}); the record is damaged"
-        ) from None
+
+
+def _columns(record: Record, what: str, registry: PluginRegistry) -> dict[str, RecordColumn]:
+    """The columns of a stored record of an uncertainty study (either layout), as
+    :func:`limits_to_record`, :func:`indices_to_record` or :func:`map_to_record` make
+    them."""
+    attributes = record.attributes
+    kind = typed.text(attributes, "kind", what)
+    if kind == KIND_LIMITS:
+        return limits_columns(
+            grid_data(record, "impact_obliquity"), limits_data(record), samples_of(record),
+            registry, _sampling(typed.json_value(attributes, "spec", what, dict)),
+        )  # fmt: skip
+    if kind == KIND_INDICES:
+        quantities = typed.json_value(attributes, "quantities", what, list)
+        names = {json.dumps(typed.json_value(attributes, f"{q}_inputs", what, list))
+                 for q in quantities}  # fmt: skip
+        if len(names) != 1:
+            raise ValueError("its quantities' indices are of different inputs")
+        return indices_columns(
+            [str(n) for n in json.loads(names.pop())],
+            {q: {key: index_data(record, q, key) for key in INDEX_KEYS} for q in quantities},
+        )
+    return map_columns(
+        grid_data(record, "impact_speed"), grid_data(record, "impact_obliquity"),
+        {name: count_data(record, name) for name in OUTCOMES},
+    )  # fmt: skip
+
+
+def cf_record(record: Record, what: str, registry: PluginRegistry) -> Record:
+    """The stored ``record`` of an uncertainty study (either layout) as this plateimpact
+    writes it: its attributes as stored, its columns over their dimensions (export)."""
+    with reading(what):
+        kind = typed.text(record.attributes, "kind", what)
+        title = _title(kind, typed.json_value(record.attributes, "plate", what, dict))
+        return Record(record.attributes, _columns(record, what, registry), title)
+
+
+#: Each kind's :func:`cf_record`, for ``plateimpact export --record``.
+CF_RECORDS = {kind: cf_record for kind in SHORT}
 
 
 def read_stored(

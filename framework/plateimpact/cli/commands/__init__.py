@@ -80,7 +80,8 @@ COMMANDS = (
         "export",
         "export",
         "write one run as netCDF-4 (FILE.nc: xarray, ncdump, Panoply) or a CSV table "
-        "(FILE.csv: one row per scene, units in the header)",
+        "(FILE.csv: one row per scene, units in the header), or a stored record (limits, a "
+        "map) as netCDF-4",
     ),
     Command(
         "upgrade",
