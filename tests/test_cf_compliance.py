@@ -111,8 +111,17 @@ def opened(path: Path) -> xarray.Dataset:
 
 def test_every_file_says_what_it_is_and_opens_in_xarray_without_a_warning(files, records):
     for path in files:
-        history = opened(path).attrs["history"]
-        assert "s/v" in history or "study s" in history
+        data = opened(path)
+        assert "s/v" in data.attrs["history"] or "study s" in data.attrs["history"]
+        # a run's trajectories are a CF discrete sampling geometry (§9.3.3: contiguous
+        # ragged array), one per scene; the scenes file has none
+        if "trajectory_count" in data:
+            assert data.attrs["featureType"] == "trajectory"
+            assert data["scene"].attrs["cf_role"] == "trajectory_id"
+            assert data["trajectory_count"].attrs["sample_dimension"] == "trajectory_sample"
+        else:
+            assert "featureType" not in data.attrs
+    assert sum("trajectory_count" in opened(path) for path in files) == 2  # run, export
     for path in records:
         data = opened(path)
         assert data.attrs["history"].startswith(data.attrs["creation_time"])

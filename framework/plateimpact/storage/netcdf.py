@@ -152,10 +152,16 @@ def write_run_file(
                 raise ArchiveError("attribute failure_state_units is not an object of unit names")
             fields = {k: trajectory_field(k, units) for k in result.trajectory.values}
             write_ragged(f, "trajectory", SAMPLE, result.trajectory, fields)
+            # CF §9: paths in time stored as a contiguous ragged array are a discrete
+            # sampling geometry, one trajectory per scene, identified by the scene
+            f.variables[SCENE].attrs["cf_role"] = "trajectory_id"
+            feature = {"featureType": "trajectory"}
+        else:
+            feature = {}
         if result.craters is not None:
             write_ragged(f, "crater", POINT, result.craters, CRATER_FIELDS)
         what = f"run {attributes.get('study')}/{attributes.get('run')}"
-        seal_file(f, {**described(what, attributes), **attributes})
+        seal_file(f, {**described(what, attributes), **feature, **attributes})
 
 
 def write_scenes_file(

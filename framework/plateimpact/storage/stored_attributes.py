@@ -108,7 +108,7 @@ def run_metadata(attributes: Mapping[str, object], what: str) -> dict[str, objec
     wall time each as the format says (the data file's own labels left out)."""
     out: dict[str, object] = {}
     for key, value in attributes.items():
-        if key in ("Conventions", "title", "history", "study", "run"):  # the file's own labels
+        if key in ("Conventions", "title", "history", "featureType", "study", "run"):  # its labels
             continue
         out[key] = value
     for key in JSON_OBJECTS:
