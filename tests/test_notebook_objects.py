@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import csv
 import math
-import sys
 
 import attrs
 import numpy as np
@@ -93,16 +92,6 @@ def test_a_studys_dataframe_has_every_run_and_the_cube_agrees(archived):
                             impact_speed=results.study.scenes.impact_speed[k])  # fmt: skip
             assert float(cell["exit_speed"]) == rows["exit_speed_m_s"].iloc[k]
     assert frame.attrs["units"]["pstar_mm"] == "mm"  # P*'s key, as the plug-in declares it
-
-
-@pytest.mark.parametrize("missing", ["pandas", "xarray"])
-def test_a_missing_table_library_is_one_line_naming_the_extra(monkeypatch, missing):
-    batch = pi.SceneBatch.grid(SPHERE, presets.plate("2024-T3/3.18"), SPEEDS, [0.0])
-    monkeypatch.setitem(sys.modules, missing, None)  # import raises ImportError
-    with pytest.raises(ImportError) as raised:
-        batch.to_dataframe()
-    message = str(raised.value)
-    assert "\n" not in message and missing in message and "plateimpact[review]" in message
 
 
 def test_a_batch_takes_its_plate_constants_units_from_their_declarations():

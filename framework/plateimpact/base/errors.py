@@ -80,6 +80,12 @@ class PluginError(PlateImpactError):
     registered. The message names the plug-ins."""
 
 
+class MissingExtraError(PlateImpactError, ImportError):
+    """An optional dependency a feature needs is not installed; the message names the
+    feature, the package and the extra that installs it (``pip install
+    'plateimpact[review]'``)."""
+
+
 class PlateImpactWarning(UserWarning):
     """Base class of plateimpact's own warnings: the command line prints each as one line,
     ``plateimpact: warning: ...``."""

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..base.errors import MissingExtraError
 from ..model.bodies import THICKNESS
 from ..provenance.metadata import versions
 from ..run.progress import reporting_scenes
@@ -91,11 +92,14 @@ def sobol(
     registry = simulation.registry
     base, quantities = check_sobol(spec, args)
     runs = None if "ballistic_limit" in quantities else base * (len(spec.inputs) + 2)
-    with reporting_scenes("uncertainty --sobol", runs):
-        found, kept = kept_indices(
-            spec, registry, base, quantities, archive_of(args), resume=args.resume,
-            simulation=simulation,
-        )  # fmt: skip
+    try:
+        with reporting_scenes("uncertainty --sobol", runs):
+            found, kept = kept_indices(
+                spec, registry, base, quantities, archive_of(args), resume=args.resume,
+                simulation=simulation,
+            )  # fmt: skip
+    except MissingExtraError as exc:  # SALib, asked for before any point runs
+        raise UsageError(f"--sobol: {exc}") from None
     if args.png is not None:
         from ..figures.sensitivity_bars import plot_sobol_indices  # noqa: PLC0415
 

@@ -14,14 +14,13 @@ xarray and pandas are imported only here, when a table is asked for.
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping, Sequence
-from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import attrs
 import numpy as np
 
+from ..base.extras import REVIEW, optional
 from ..base.parameters import Parameter
 from .fields import CORE_COLUMNS, RESULT_FIELDS, Outcome
 
@@ -36,8 +35,6 @@ FLAGS: dict[str, tuple[list[int], str]] = {
     "outcome": ([int(o) for o in Outcome], " ".join(o.label for o in Outcome)),
     "plate_failed": ([0, 1], "intact failed"),
 }
-#: The extra that brings what the tables need (pyproject.toml).
-REVIEW_EXTRA = "plateimpact[review]"
 SCENE = "scene"
 #: The index of a scene in its batch or study, and its plate's label.
 SCENE_INDEX = Parameter(SCENE, "the scene's index in its study, from 0", kind=int)
@@ -46,17 +43,6 @@ VARIANT = Parameter("variant", "the run's name: a model variant of the study", k
 
 #: A column: its dimensions, its values [SI] and its declaration.
 Column = tuple[tuple[str, ...], np.ndarray, Parameter]
-
-
-def optional(module: str, wanted_by: str) -> ModuleType:
-    """``module`` imported, or ImportError in one line naming what wanted it and the
-    extra that installs it."""
-    try:
-        return importlib.import_module(module)
-    except ImportError:
-        raise ImportError(
-            f"{wanted_by} needs {module}, which is not installed: pip install '{REVIEW_EXTRA}'"
-        ) from None
 
 
 def long_name(declared: Parameter) -> str:
@@ -155,7 +141,7 @@ class LabelledTable:
 
     def to_xarray(self) -> xarray.Dataset:
         """A Dataset [SI], every variable and coordinate with its CF attributes."""
-        xr = optional("xarray", "to_xarray")
+        xr = optional("xarray", "to_xarray", REVIEW)
 
         def entries(columns: dict[str, Column]) -> dict[str, Any]:
             return {
@@ -174,7 +160,7 @@ class LabelledTable:
         dimensions (their keys the index), each column named with its unit (the
         column's ``key``: ``impact_speed_m_s``); ``attrs["units"]``: the unit of each
         column whose unit is known ("1" for a pure number)."""
-        pd = optional("pandas", "to_dataframe")
+        pd = optional("pandas", "to_dataframe", REVIEW)
         flat = self.to_xarray().to_dataframe().reset_index()
         declared = {name: column[2] for name, column in self.coordinates.items()}
         declared.update({name: column[2] for name, column in self.variables.items()})

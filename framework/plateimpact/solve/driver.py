@@ -18,6 +18,7 @@ import warnings
 import numpy as np
 
 from ..base.errors import CompiledPathWarning, ParameterError
+from ..base.extras import FAST
 from ..model.batch import SceneBatch
 from ..model.binding import BoundBatch
 from ..model.events import EVENT_OUTCOMES, EVENTS, ONSET, RESTARTING, TURNED_BACK
@@ -66,7 +67,7 @@ def choose_engine(requested: str, model: ImpactModel, integrator: Integrator, si
     reason = unavailable_reason(model, integrator)
     law, failure = type(model.resistance), type(model.failure)
     if reason is None and importlib.util.find_spec("numba") is None:
-        reason = "numba is not installed (pip install 'plateimpact[fast]')"
+        reason = f"numba is not installed (pip install '{FAST}')"
         if requested == "auto":
             warn_once(reason)
     if reason is not None:

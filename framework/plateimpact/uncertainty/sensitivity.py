@@ -17,6 +17,7 @@ from typing import Any
 import attrs
 import numpy as np
 
+from ..base.extras import SOBOL, optional
 from ..model.results import Outcome
 from ..registry.plugin_registry import PluginRegistry
 from ..run.simulation import Simulation
@@ -80,6 +81,7 @@ def sobol_indices(
     """S1 and ST of ``quantity`` (a function of the inputs' values, by name, one per
     point) to each of ``distributions``, from ``base_samples`` × (inputs + 2) points
     (Saltelli's scheme; ``base_samples`` a power of 2 keeps the Sobol' points balanced)."""
+    optional("SALib", "sobol_indices", SOBOL)  # before any point runs
     from SALib.analyze import sobol as analyze  # noqa: PLC0415 (a heavy import)
     from SALib.sample import sobol as sample  # noqa: PLC0415
 

@@ -9,6 +9,7 @@ import argparse
 import json
 import time
 
+from ...base.extras import FAST, optional
 from ...registry.plugin_registry import PluginRegistry
 from ...solve.compiled import program, warming
 from ..writer import Writer
@@ -19,6 +20,7 @@ def arguments(parser: argparse.ArgumentParser, registry: PluginRegistry) -> None
 
 
 def run(args: argparse.Namespace, registry: PluginRegistry, out: Writer) -> int:
+    optional("numba", "compile", FAST)  # one line, not one failure per pair
     pairs = warming.compiled_pairs(registry)
     start = time.perf_counter()
     done = warming.compile_pairs(pairs)
