@@ -4,7 +4,7 @@ extra): every check at every priority passes, the global ``title`` and ``history
 §2.6.2) included, and xarray opens each file with no warning. The files: a run, its
 study's scenes and the run exported; a stored record of every kind (limits, an outcome
 map, an uncertainty study's sampled limits, Sobol' indices and probability map) and a
-record exported."""
+record exported; and each layout of file in the archive ``plateimpact reproduce`` writes."""
 
 from __future__ import annotations
 
@@ -155,3 +155,22 @@ def test_a_record_is_labelled_by_its_dimensions(records):
     assert (counts == 4).all()  # every sample ends somewhere at every point
     exported = opened(records[-1])
     xarray.testing.assert_identical(exported, grid)  # the stored map, attributes and all
+
+
+def test_every_layout_in_the_reproduce_archive_passes_every_cf_check(quick_report, tmp_path):
+    """The data files of the archive ``plateimpact reproduce`` writes: one file of each
+    layout (the same variables and global attribute names: a study's runs differ in
+    their numbers only) checked, and every file opened in xarray with no warning."""
+    data = sorted((quick_report / "report.h5.d").glob("*.nc"))
+    layouts: dict[tuple[frozenset[str], frozenset[str]], Path] = {}
+    for path in data:
+        opened_file = opened(path)
+        key = (frozenset(opened_file.variables), frozenset(opened_file.attrs))
+        layouts.setdefault(key, path)
+    # STUDY.RUN.DIGEST.nc or limits.NAME.DIGEST.nc: a run, a study's scenes, the crater
+    # study's run (with crater sections), the outcome maps
+    kinds = {path.name.rsplit(".", 3)[1] for path in layouts.values()}
+    assert {"plugging", "scenes", "default"} <= kinds, kinds
+    assert any(path.name.startswith("limits.map_") for path in layouts.values())
+    for path in layouts.values():
+        assert failed_checks(path, tmp_path / "report.json") == [], path.name
