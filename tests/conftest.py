@@ -166,6 +166,17 @@ try:
     settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 except ImportError:  # hypothesis is a test extra
     pass
+try:
+    # Hypothesis (6.131 on) also draws numbers it finds in the local modules imported so
+    # far, so a derandomized test's examples would depend on which tests ran before it
+    # in its process: under pytest-xdist, on the scheduling and so on the machine's load
+    # (the intact/segment property test drew scenes 8x as long in the whole suite as
+    # alone). The suite keeps that pool empty: a test's examples are its own.
+    from hypothesis.internal.conjecture import providers as _providers
+
+    _providers._get_local_constants = lambda: _providers._local_constants
+except (ImportError, AttributeError):  # an older Hypothesis has no such pool
+    pass
 
 
 @pytest.fixture(scope="session")
