@@ -4,7 +4,7 @@ scene at a time (scalar) and in lanes of scenes side by side (SIMD), for numba.
 Both are built from the package's own kernels of numbers (``geometry.KERNELS``,
 ``force_on_contact``, ``poncelet_stress``; tests/test_kernels.py compiles them the same
 way), so the physics is written once here too. The scalar code calls
-``contact_geometry_kernel``, whose turn-around ring is an ``if``; a lane computes eq 6 in
+``contact_surface_kernel``, whose turn-around ring is an ``if``; a lane computes eq 6 in
 every lane and the ring (its arctan2 and six sines and cosines) only when one of its
 lanes needs it, selected per lane. Every lane loop is ``for j in range(width)`` with
 ``width`` a run-time argument: LLVM's loop vectorizer turns it into vector code (a
@@ -23,7 +23,7 @@ import numpy as np
 from plateimpact.model import geometry
 from plateimpact.model.geometry import (
     _clamp,
-    contact_geometry_kernel,
+    contact_surface_kernel,
     contact_lost_margin,
     entry_edge_angle,
     in_turnaround_ring,
@@ -31,11 +31,11 @@ from plateimpact.model.geometry import (
     presented_area,
     ring_inclination,
 )
-from plateimpact.model.resistance import force_on_contact
+from plateimpact.model.resistance import force_on_contact, force_on_surface
 from plateimpact_plugins.dopri5 import DormandPrince54
 from plateimpact_plugins.poncelet import poncelet_stress
 
-for _kernel in (*geometry.KERNELS, force_on_contact, poncelet_stress):
+for _kernel in (*geometry.KERNELS, force_on_surface, force_on_contact, poncelet_stress):
     numba.extending.register_jitable(_kernel)
 
 # The Dormand-Prince 5(4) tableau (the package's, as compile-time constants) and the
@@ -60,7 +60,7 @@ def scalar_rates(p, theta, v, held, rs, mass, a, b):
     image of |θ|, and θ is held once it has turned back."""
     side = -1.0 if theta < 0.0 else 1.0
     drag, lift = force_on_contact(
-        p, abs(theta), v, rs, contact_geometry_kernel, poncelet_stress, (a, b)
+        p, abs(theta), v, rs, contact_surface_kernel, poncelet_stress, (a, b)
     )
     theta_rate = 0.0 if held else side * lift / (mass * v)
     return v * np.cos(theta), v * np.sin(theta), theta_rate, -drag / mass
@@ -68,7 +68,7 @@ def scalar_rates(p, theta, v, held, rs, mass, a, b):
 
 def lane_forces(pen, obl, speed, start, width, rs, a, b, phi, drag, lift):
     """Drag and lift [N] of the lanes start ... start + width − 1 (eqs 1–6, 22–24):
-    ``contact_geometry_kernel`` and ``force_on_contact`` with the ring's ``if`` made a
+    ``contact_surface_kernel`` and ``force_on_contact`` with the ring's ``if`` made a
     select. ``phi`` is scratch of ``width``; ``obl`` is |θ|."""
     ring_somewhere = False
     for j in range(width):
@@ -333,7 +333,7 @@ def scalar_forces(pen, obl, speed, rs, a, b, drag, lift):
     """Drag and lift [N] of every state, one at a time (the kernel the compiled path calls)."""
     for i in range(pen.size):
         drag[i], lift[i] = force_on_contact(
-            pen[i], obl[i], speed[i], rs, contact_geometry_kernel, poncelet_stress, (a, b)
+            pen[i], obl[i], speed[i], rs, contact_surface_kernel, poncelet_stress, (a, b)
         )
 
 
