@@ -23,8 +23,8 @@ import numpy as np
 from plateimpact.model import geometry
 from plateimpact.model.geometry import (
     _clamp,
-    contact_surface_kernel,
     contact_lost_margin,
+    contact_surface_kernel,
     entry_edge_angle,
     in_turnaround_ring,
     inclination_bisector,
