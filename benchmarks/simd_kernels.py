@@ -35,7 +35,19 @@ from plateimpact.model.resistance import force_on_contact, force_on_surface
 from plateimpact_plugins.dopri5 import DormandPrince54
 from plateimpact_plugins.poncelet import poncelet_stress
 
-for _kernel in (*geometry.KERNELS, force_on_surface, force_on_contact, poncelet_stress):
+
+def stress_of_pair(speed, incidence, pair):
+    """Poncelet's σ [N/m²] with its (a, b) as one argument, as a stress kernel takes it."""
+    return poncelet_stress(speed, incidence, pair[0], pair[1])
+
+
+for _kernel in (
+    *geometry.KERNELS,
+    force_on_surface,
+    force_on_contact,
+    poncelet_stress,
+    stress_of_pair,
+):
     numba.extending.register_jitable(_kernel)
 
 # The Dormand-Prince 5(4) tableau (the package's, as compile-time constants) and the
@@ -60,7 +72,7 @@ def scalar_rates(p, theta, v, held, rs, mass, a, b):
     image of |θ|, and θ is held once it has turned back."""
     side = -1.0 if theta < 0.0 else 1.0
     drag, lift = force_on_contact(
-        p, abs(theta), v, rs, contact_surface_kernel, poncelet_stress, (a, b)
+        p, abs(theta), v, rs, contact_surface_kernel, stress_of_pair, (a, b)
     )
     theta_rate = 0.0 if held else side * lift / (mass * v)
     return v * np.cos(theta), v * np.sin(theta), theta_rate, -drag / mass
@@ -333,7 +345,7 @@ def scalar_forces(pen, obl, speed, rs, a, b, drag, lift):
     """Drag and lift [N] of every state, one at a time (the kernel the compiled path calls)."""
     for i in range(pen.size):
         drag[i], lift[i] = force_on_contact(
-            pen[i], obl[i], speed[i], rs, contact_surface_kernel, poncelet_stress, (a, b)
+            pen[i], obl[i], speed[i], rs, contact_surface_kernel, stress_of_pair, (a, b)
         )
 
 

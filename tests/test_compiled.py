@@ -69,6 +69,8 @@ def _baseline_numpy_results(tmp_path: Path) -> dict[str, np.ndarray]:
         "import sys, numpy as np\n"
         f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
         "from test_compiled import FAILURES, run\n"
+        "from plateimpact.solve.compiled.elementary import in_numpy_path\n"
+        "in_numpy_path()\n"
         "found = {}\n"
         "for failure in FAILURES:\n"
         "    r = run(failure, 'numpy')\n"
@@ -94,7 +96,8 @@ def baseline(tmp_path_factory):
 def test_compiled_path_takes_the_numpy_paths_steps(failure, baseline):
     """Same outcome, failure and work per scene; exit speed within 1e-12 Vs, exit
     obliquity within 1e-9°, times and depths to rounding, on 2,000 scenes over every
-    preset: the same algorithm, step for step, with the same math library."""
+    preset: the same algorithm, step for step, with the same elementary functions (the
+    compiled path's, in the numpy path too) and the same C library for the rest."""
     scenes = batch()
     compiled = run(failure, "compiled", scenes)
     assert compiled.stats["compiled_scenes"] == scenes.size
@@ -130,6 +133,33 @@ def test_compiled_path_agrees_with_the_default_numpy(failure):
     assert np.max(np.abs(compiled.exit_speed - numpy_path.exit_speed) / speed) <= 2e-7
     angle = np.abs(compiled.columns["exit_obliquity"] - numpy_path.columns["exit_obliquity"])
     assert np.degrees(np.max(angle)) <= 1e-5
+
+
+def test_lanes_give_what_one_scene_at_a_time_gives_bit_for_bit(monkeypatch):
+    """The compiled path steps 16 scenes together (solve/compiled/lanes.py), each lane
+    doing the one-at-a-time driver's operations in its order: every result and count
+    equal bit for bit, trajectories included, on the hinge (failure state, four branch
+    rows, the finger) over every preset, with plates failing, the ring and all five
+    outcomes among the scenes; and in reverse order (other neighbours in each lane)."""
+    from plateimpact.solve.compiled import building  # noqa: PLC0415
+
+    simulation = pi.Simulation.from_names(failure="hinge", engine="compiled")
+    scenes = batch(600, seed=11)
+    lanes = simulation.run_batch(scenes, record_trajectory=True)
+    assert len(set(lanes.outcome.tolist())) >= 3 and lanes.columns["plate_failed"].any()
+    reverse = np.arange(scenes.size)[::-1]
+    backwards = simulation.run_batch(scenes.take(reverse))
+    program = building.build(type(simulation.model.resistance), type(simulation.model.failure))
+    monkeypatch.setattr(program, "run", program.run_one_at_a_time)
+    alone = simulation.run_batch(scenes, record_trajectory=True)
+    assert lanes.stats == alone.stats
+    for name, column in lanes.columns.items():
+        np.testing.assert_array_equal(column, alone.columns[name], err_msg=name)
+        np.testing.assert_array_equal(column[reverse], backwards.columns[name], err_msg=name)
+    for i in (0, 299, 599):
+        a, b = lanes.trajectory_of(i), alone.trajectory_of(i)
+        for name in ("time", "penetration", "lateral", "obliquity", "speed"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
 
 
 def test_auto_runs_compiled_whatever_the_size_and_chunking_changes_nothing():

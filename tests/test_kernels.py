@@ -18,7 +18,7 @@ from plateimpact.model.resistance import force_on_contact
 from plateimpact_plugins import hinge, separation
 from plateimpact_plugins.hinge import Hinge
 from plateimpact_plugins.plugging import Plugging
-from plateimpact_plugins.poncelet import Poncelet, poncelet_stress
+from plateimpact_plugins.poncelet import Poncelet, poncelet_stress, poncelet_stress_kernel
 
 numba = pytest.importorskip("numba")
 
@@ -29,7 +29,7 @@ RTOL = 1e-13  # relative to each quantity's scale: π Rs² [m²], Rs [m], π [ra
 @pytest.fixture(scope="module")
 def compiled():
     """njit of every kernel, callees registered first so that callers compile."""
-    kernels = (*geometry.KERNELS, force_on_contact, poncelet_stress)
+    kernels = (*geometry.KERNELS, force_on_contact, poncelet_stress, poncelet_stress_kernel)
     kernels += (*separation.KERNELS, *hinge.KERNELS)
     for kernel in kernels:
         numba.extending.register_jitable(kernel)
@@ -129,13 +129,14 @@ def test_contact_force_kernel_equals_the_laws_force(compiled, states):
 def _force_per_scene(compiled, states, depth=None):
     """Drag and lift [N] of the compiled force (or relief, below ``depth``) per scene."""
     force = compiled["force_on_contact"]
-    geometry_c, stress_c = compiled["contact_surface_kernel"], compiled["poncelet_stress"]
+    geometry_c = compiled["contact_surface_kernel"]
+    stress_c = compiled["poncelet_stress_kernel"]
     out = []
     for i in range(N):
         p, theta, speed, rs = (
             float(states[k][i]) for k in ("penetration", "obliquity", "speed", "radius")
         )
-        args = (rs, geometry_c, stress_c, (float(states["a"][i]), float(states["b"][i])))
+        args = (rs, geometry_c, stress_c, np.array([states["a"][i], states["b"][i]], float))
         if depth is None:
             out.append(force(p, theta, speed, *args))
         else:

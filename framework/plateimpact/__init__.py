@@ -134,6 +134,7 @@ _SUBMODULES: dict[str, str] = {
     "calibration": "calibration",
     "command_line": "cli.toolkit",
     "display": "base.display",
+    "elementary": "model.elementary",
     "experiment": "experiment",
     "geometry": "model.geometry",
     "kernels": "model.kernels",
@@ -228,7 +229,7 @@ if TYPE_CHECKING:  # what type checkers and IDEs see
     from .comparison import Comparison
     from .experiment import ValidationReport, validate
     from .experiment.synthetic_shots import synthetic_oblique_shots, synthetic_shots
-    from .model import batch, geometry, kernels
+    from .model import batch, elementary, geometry, kernels
     from .model.binding import BoundBatch
     from .model.bodies import Plate, Sphere
     from .model.events import (

@@ -14,7 +14,9 @@ function runs on arrays (one value per scene, the numpy path) and on numbers (nu
 compiles it for a per-scene loop, the compiled path) with the same results. Where a
 formula switches branch per scene (the turn-around ring of eq 6), an array function
 selects with a mask and a ``*_kernel`` twin with an ``if``, both calling the same
-formulas; :data:`KERNELS` lists what a compiled path compiles. All arccos/arcsin
+formulas; :data:`KERNELS` lists what a compiled path compiles. Square roots, sines,
+cosines and arccos come from :mod:`.elementary` (numpy's on arrays, branch-free
+polynomials when compiled, so that lanes of scenes vectorise). All arccos/arcsin
 arguments are clamped to [−1, 1]: they leave it in legitimate states (docs/model.md §2,
 "Clamps"), and the clamped values are the report's own special cases ("then Γe = 2π",
 "then Γs = 0").
@@ -26,6 +28,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+
+from .elementary import arccos, sin, sincos, sqrt
 
 HALF_PI = 0.5 * np.pi
 TWO_PI = 2.0 * np.pi
@@ -49,7 +53,7 @@ def entry_edge_angle(penetration: Any, radius: Any) -> Any:
     """α1 [rad]: angle, at the centre and from the inward normal, of the point where the
     front surface cuts the sphere in the plane of motion. 0 at first contact, π/2 when
     the centre reaches the surface, π once the sphere is wholly below it."""
-    return np.arccos(_clamp((radius - penetration) / radius, -1.0, 1.0))
+    return arccos(_clamp((radius - penetration) / radius, -1.0, 1.0))
 
 
 def inclination_bisector(alpha1: Any, obliquity: Any) -> Any:
@@ -110,11 +114,22 @@ def force_inclination(penetration: Any, obliquity: Any, radius: Any) -> np.ndarr
 def force_inclination_kernel(penetration: float, obliquity: float, radius: float) -> float:
     """:func:`force_inclination` of numbers [rad], for a compiled path: the same formulas,
     selected per scene."""
+    phi, ring, alpha1, bisector = eq6_inclination(penetration, obliquity, radius)
+    if ring:
+        return ring_inclination(alpha1, obliquity, bisector)
+    return phi
+
+
+def eq6_inclination(
+    penetration: float, obliquity: float, radius: float
+) -> tuple[float, bool, float, float]:
+    """φ [rad] of eq 6 (clamped to [0, θ]), whether the state lies in the turn-around
+    ring instead (where :func:`ring_inclination` applies), α1 and the bisector [rad]:
+    without a branch, so that a loop over lanes of scenes vectorises it."""
     alpha1 = entry_edge_angle(penetration, radius)
     bisector = inclination_bisector(alpha1, obliquity)
-    if in_turnaround_ring(alpha1, obliquity):
-        return ring_inclination(alpha1, obliquity, bisector)
-    return _clamp(bisector, 0.0, obliquity)  # eq 6
+    ring = in_turnaround_ring(alpha1, obliquity)
+    return _clamp(bisector, 0.0, obliquity), ring, alpha1, bisector
 
 
 def limit_ratio(numerator: Any, denominator: Any) -> Any:
@@ -147,21 +162,21 @@ def _surface(
     """A [m²] (eq 2), φ [rad], cos ψ and sin ψ of the incidence ψ = θ − φ (eq 22), and
     sin θ, cos θ, with each sine and cosine evaluated once: the force needs them all
     (eqs 2, 23, 24), and the motion sin θ and cos θ (eqs 25, 26)."""
-    sin_t, cos_t = np.sin(obliquity), np.cos(obliquity)
-    sin_phi, cos_phi = np.sin(inclination), np.cos(inclination)
+    sin_t, cos_t = sincos(obliquity)
+    sin_phi, cos_phi = sincos(inclination)
     cos_psi = cos_t * cos_phi + sin_t * sin_phi  # cos(θ − φ)
     sin_psi = sin_t * cos_phi - cos_t * sin_phi  # sin(θ − φ)
     centre_height = radius - penetration  # height of the centre above the front plane
     re_squared = embedment_radius_squared(penetration, radius)
     # eq 4, (Rs − P)/(Re tan θ) written with sin and cos so that θ = 0 is a limit.
-    ratio_e = limit_ratio(centre_height * cos_t, np.sqrt(re_squared) * sin_t)
+    ratio_e = limit_ratio(centre_height * cos_t, sqrt(re_squared) * sin_t)
     ratio_s = limit_ratio(centre_height, radius * sin_t)  # eq 5
     # Γ − sin Γ for Γe = 2π − 2 arccos r and Γs = 2 arccos r, with sin(2 arccos r) written
     # as 2 r √(1 − r²): the same values without two more sine evaluations.
-    chord_e = 2.0 * ratio_e * np.sqrt(1.0 - ratio_e * ratio_e)
-    chord_s = 2.0 * ratio_s * np.sqrt(1.0 - ratio_s * ratio_s)
-    segment_e = TWO_PI - 2.0 * np.arccos(ratio_e) + chord_e  # Γe − sin Γe
-    segment_s = 2.0 * np.arccos(ratio_s) - chord_s  # Γs − sin Γs
+    chord_e = 2.0 * ratio_e * sqrt(1.0 - ratio_e * ratio_e)
+    chord_s = 2.0 * ratio_s * sqrt(1.0 - ratio_s * ratio_s)
+    segment_e = TWO_PI - 2.0 * arccos(ratio_e) + chord_e  # Γe − sin Γe
+    segment_s = 2.0 * arccos(ratio_s) - chord_s  # Γs − sin Γs
     area = 0.5 * re_squared * segment_e * cos_phi + 0.5 * radius**2 * segment_s * cos_psi  # eq 2
     return area, inclination, cos_psi, sin_psi, sin_t, cos_t
 
@@ -227,7 +242,7 @@ def branch_surfaces(penetration: Any, obliquity: Any, radius: Any) -> tuple[Any,
     has a corner. An adaptive integrator steps onto these surfaces rather than across
     them (docs/integrators.md, "branch surfaces"). θ in [0, π].
     """
-    lift = radius * np.sin(obliquity)
+    lift = radius * sin(obliquity)
     return penetration - (radius - lift), penetration - (radius + lift)
 
 
@@ -248,7 +263,7 @@ def contact_lost_margin(penetration: Any, obliquity: Any, radius: Any) -> Any:
     and of the same sign everywhere, but smooth across it, so its root is found in
     fewer iterations. θ in [0, π].
     """
-    return np.minimum(obliquity - HALF_PI, (radius - penetration) / radius - np.sin(obliquity))
+    return np.minimum(obliquity - HALF_PI, (radius - penetration) / radius - sin(obliquity))
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
@@ -259,6 +274,7 @@ KERNELS = (
     inclination_bisector,
     in_turnaround_ring,
     ring_inclination,
+    eq6_inclination,
     force_inclination_kernel,
     limit_ratio,
     _surface,

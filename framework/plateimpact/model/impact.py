@@ -10,6 +10,7 @@ import numpy as np
 
 from ..base.errors import PluginError
 from ..base.parameters import Parameter, Range
+from . import elementary
 from .batch import SceneBatch
 from .binding import BoundBatch, bind_scenes, check_declarations
 from .events import (
@@ -221,8 +222,10 @@ class ImpactModel:
         mass = batch.core.mass
         obliquity_rate = np.where(held, 0.0, lift / (mass * spd))
         dy = np.empty_like(y)
-        dy[PENETRATION] = spd * np.cos(obl)
-        dy[LATERAL] = spd * np.sin(obl)
+        # the geometry's sine and cosine (its own functions: the compiled path takes
+        # them from the contact surface it has just evaluated, the same numbers)
+        dy[PENETRATION] = spd * elementary.cos(obl)
+        dy[LATERAL] = spd * elementary.sin(obl)
         dy[OBLIQUITY] = obliquity_rate
         dy[SPEED] = -drag / mass
         # The failure model sees the mirror image for θ < 0: |θ| and d|θ|/dt.

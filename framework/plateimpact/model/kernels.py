@@ -68,7 +68,7 @@ def law_force(
         contact.radius,
         contact_surface_kernel,
         contact.stress,
-        (contact.law_constants,),
+        contact.law_constants,
     )
 
 

@@ -55,7 +55,7 @@ def force_on_contact(
     radius: Any,
     surface: Callable[..., tuple[Any, ...]],
     stress: Callable[..., Any],
-    stress_args: tuple[Any, ...],
+    stress_argument: Any,
 ) -> tuple[Any, Any]:
     """Drag and lift [N] on the contact surface (eqs 1, 22–24) at ``penetration`` P [m],
     ``obliquity`` θ [rad] and ``speed`` V [m/s] of a sphere of ``radius`` Rs [m]: the
@@ -63,12 +63,13 @@ def force_on_contact(
 
     ``surface(P, θ, Rs)`` gives the presented area A [m²], the force inclination φ [rad]
     and cos ψ, sin ψ of the incidence (:func:`~plateimpact.model.geometry.contact_surface`
-    on arrays, its ``_kernel`` on numbers) and ``stress(V, ψ, *stress_args)`` the stress
-    σ [N/m²] (a law's ``stress`` with its view of the scenes, or a compiled stress kernel
-    with its constants).
+    on arrays, its ``_kernel`` on numbers) and ``stress(V, ψ, stress_argument)`` the
+    stress σ [N/m²] (a law's ``stress`` with its view of the scenes, or a compiled stress
+    kernel with a scene's constants: one argument, not a tuple to unpack, so that
+    compiled code can inline this).
     """
     return force_on_surface(
-        surface(penetration, obliquity, radius), obliquity, speed, stress, stress_args
+        surface(penetration, obliquity, radius), obliquity, speed, stress, stress_argument
     )
 
 
@@ -77,14 +78,20 @@ def force_on_surface(
     obliquity: Any,
     speed: Any,
     stress: Callable[..., Any],
-    stress_args: tuple[Any, ...],
+    stress_argument: Any,
 ) -> tuple[Any, Any]:
     """``force_on_contact`` from the contact ``surface`` already evaluated at
     ``obliquity`` θ [rad] (the geometry's A [m²], φ [rad], cos ψ, sin ψ, ...), at
     ``speed`` V [m/s]: drag and lift [N] (eqs 1, 22–24)."""
-    area, inclination, cos_incidence, sin_incidence = surface[0], surface[1], surface[2], surface[3]
-    force = area * stress(speed, obliquity - inclination, *stress_args)  # eqs 1, 22
-    return force * cos_incidence, force * sin_incidence  # eqs 23, 24
+    stress_value = stress(speed, obliquity - surface[1], stress_argument)  # eqs 1, 22
+    return force_from_stress(surface, stress_value)
+
+
+def force_from_stress(surface: tuple[Any, ...], stress_value: Any) -> tuple[Any, Any]:
+    """Drag and lift [N] of the stress σ [N/m²] on the contact ``surface`` (A [m²], φ,
+    cos ψ, sin ψ, ...): F = A σ along the contact-plane normal (eqs 1, 23, 24)."""
+    force = surface[0] * stress_value
+    return force * surface[2], force * surface[3]
 
 
 def contact_force(
@@ -104,7 +111,7 @@ def contact_force(
     ``batch`` is the law's view of the scenes.
     """
     return force_on_contact(
-        penetration, obliquity, speed, batch.radius, contact_surface, law.stress, (batch,)
+        penetration, obliquity, speed, batch.radius, contact_surface, law.stress, batch
     )
 
 
@@ -148,4 +155,4 @@ class BoundResistance:
 
 
 #: The functions of numbers a compiled path compiles.
-KERNELS = (force_on_surface, force_on_contact)
+KERNELS = (force_from_stress, force_on_surface, force_on_contact)

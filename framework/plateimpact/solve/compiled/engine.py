@@ -25,7 +25,7 @@ from .building import build
 #: Scenes handed to a thread at a time: small enough to balance scenes of very different
 #: cost (a map's slow perforations beside its quick ricochets) over the cores, large
 #: enough that handing them out (some microseconds) costs nothing.
-PARALLEL_CHUNK = 64
+PARALLEL_CHUNK = 256
 _threads: list[int] = [0]  # 0: one per core
 
 

@@ -60,6 +60,18 @@ def contact_of(
     )  # fmt: skip
 
 
+def motion(
+    surface: Any, drag: float, lift: float, side: float, speed: float, mass: float, held: bool
+) -> tuple[float, float, float, float]:
+    """dP/dt [m/s], dY/dt [m/s], dθ/dt [rad/s] and dV/dt [m/s²] (eqs 25–28) from the
+    contact ``surface`` at |θ|, the drag and lift [N] on it at |θ|, the side of θ (±1),
+    the speed V [m/s] and the mass m [kg]; θ does not turn once held at 180°."""
+    obliquity_rate = 0.0 if held else (side * lift) / (mass * speed)
+    # cos θ = cos |θ| and sin θ = side · sin |θ| exactly (cos is even, sin odd): the
+    # surface's own, not two more evaluations
+    return speed * surface[5], speed * (side * surface[4]), obliquity_rate, -drag / mass
+
+
 def rates(
     model: CompiledModel, scene: SceneConstants, y: Any, failed: bool, held: bool, out: Any
 ) -> None:
@@ -68,20 +80,15 @@ def rates(
     side = -1.0 if theta < 0.0 else 1.0
     obliquity = np.abs(theta)
     surface = contact_surface_kernel(y[P_], obliquity, scene.radius)
-    drag, lift = force_on_surface(surface, obliquity, speed, model.stress, (scene.law_constants,))
+    drag, lift = force_on_surface(surface, obliquity, speed, model.stress, scene.law_constants)
     if failed:
         extra_drag, extra_lift = model.force_change(contact_of(model, scene, y, obliquity, np.nan))
         drag, lift = drag + extra_drag, lift + extra_lift
-    lift = side * lift
-    obliquity_rate = 0.0 if held else lift / (scene.mass * speed)
-    # cos θ = cos |θ| and sin θ = side · sin |θ| exactly (the libm's cos is even, its sin
-    # odd): the surface's own, not two more evaluations
-    out[P_] = speed * surface[5]
-    out[Y_] = speed * (side * surface[4])
-    out[THETA_] = obliquity_rate
-    out[V_] = -drag / scene.mass
+    out[P_], out[Y_], out[THETA_], out[V_] = motion(
+        surface, drag, lift, side, speed, scene.mass, held
+    )
     if failed:
-        contact = contact_of(model, scene, y, side * theta, side * obliquity_rate)
+        contact = contact_of(model, scene, y, side * theta, side * out[THETA_])
         model.state_rates(contact, out[STATE:])
     else:
         for row in range(STATE, y.size):
@@ -93,17 +100,28 @@ def event_margins(
 ) -> None:
     """The event margins into ``out`` (:meth:`ImpactModel.event_margins`, every row)."""
     penetration, obliquity = y[P_], np.abs(y[THETA_])
-    if scene.adds_onset and not failed:
-        out[ONSET] = penetration - scene.onset_penetration
-    else:
-        out[ONSET] = -np.inf
-    out[CONTACT_LOST] = contact_lost_margin(penetration, obliquity, scene.radius)
+    out[ONSET], out[CONTACT_LOST], out[AT_REST], out[TURNED_BACK] = kinematic_margins(
+        penetration, obliquity, y[V_], scene.radius, scene.rest_speed,
+        scene.onset_penetration, scene.turn_back_limit, scene.adds_onset, failed, held,
+    )  # fmt: skip
     if scene.adds_perforation and failed and obliquity < HALF_PI:
         out[PERFORATED] = model.perforation_margin(contact_of(model, scene, y, obliquity, np.nan))
     else:
         out[PERFORATED] = -np.inf
-    out[AT_REST] = scene.rest_speed - y[V_]
-    out[TURNED_BACK] = -np.inf if held else obliquity - scene.turn_back_limit
+
+
+def kinematic_margins(
+    penetration: float, obliquity: float, speed: float, radius: float, rest_speed: float,
+    onset_penetration: float, turn_back_limit: float, adds_onset: bool, failed: bool,
+    held: bool,
+) -> tuple[float, float, float, float]:  # fmt: skip
+    """The margins of failure onset, loss of contact, rest and turn-back at P [m],
+    |θ| [rad] and V [m/s] (−inf where the event cannot happen): what every failure model
+    shares of :func:`event_margins`, as plain arithmetic."""
+    onset = penetration - onset_penetration if adds_onset and not failed else -np.inf
+    contact_lost = contact_lost_margin(penetration, obliquity, radius)
+    turned_back = -np.inf if held else obliquity - turn_back_limit
+    return onset, contact_lost, rest_speed - speed, turned_back
 
 
 def branch_margins(
@@ -121,4 +139,4 @@ def branch_margins(
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
-KERNELS = (contact_of, rates, event_margins, branch_margins)
+KERNELS = (contact_of, motion, rates, kinematic_margins, event_margins, branch_margins)

@@ -63,6 +63,77 @@ def scratch(
     return work, ev, np.empty(events)
 
 
+def settle(
+    model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, ev: EventWork,
+    y: Any, h: float, t: float, failed: bool, held: bool, max_penetration: float, row: int,
+    writing: bool, trajectory: Any, outcomes: Any, restarts: Any, embedment: int,
+    results: Any, counts: Any,
+) -> tuple[float, bool, bool, float, int, bool, bool, bool]:  # fmt: skip
+    """An accepted step of length ``h`` [s] from ``y`` at time ``t`` [s], whose dense
+    output, samples and event margins are in ``work`` and ``ev``: its first event, the
+    maximum penetration and the trajectory rows up to it, and ``y`` moved to the step's
+    end or the event (with the carried derivative in ``work.stages[0]``). Returns the new
+    time [s], failed, held, maximum penetration [m] and next row, and whether an event
+    happened, whether the right-hand side was restarted (one more evaluation) and
+    whether the scene ended (its results written)."""
+    at, samples = ev.at, ev.samples
+    s = tab.C.size
+    event_sigma, kind, crest_sigma = first_event(
+        model, scene, ev, work.coefficients, y, failed, held
+    )
+    hit = np.isfinite(event_sigma)
+    end_sigma = event_sigma if hit else 1.0
+    # Maximum penetration: at the samples inside the step, its end, and the crest.
+    peak = -np.inf
+    for j in range(at.size):
+        if at[j] <= end_sigma:
+            peak = np.maximum(peak, samples[j, P_])
+    if hit:
+        dense_state(work.coefficients, y, end_sigma, ev.state)
+    else:
+        copy(ev.state, work.y_new)
+    peak = np.maximum(peak, ev.state[P_])
+    if crest_sigma < end_sigma:
+        dense_state(work.coefficients, y, crest_sigma, work.trial)
+        peak = np.maximum(peak, work.trial[P_])
+        # the deepest point belongs to the path
+        row = record(trajectory, row, writing, t + crest_sigma * h, work.trial, failed)
+    max_penetration = np.maximum(max_penetration, peak)
+    for j in range(1, at.size):
+        if at[j] < end_sigma:
+            row = record(trajectory, row, writing, t + at[j] * h, samples[j], failed)
+    t = t + end_sigma * h
+    copy(y, ev.state)
+    copy(work.stages[0], work.stages[s])  # the carried derivative (FSAL)
+    if not hit:
+        if tab.branch_landing:  # judge's margins at the step's end: now y's
+            copy(work.margins, work.ahead)
+        row = record(trajectory, row, writing, t, y, failed)  # the step's end
+        return t, failed, held, max_penetration, row, False, False, False
+    if kind == ONSET:
+        failed = True
+        if y.size > STATE:
+            contact = _contact_of(model, scene, y, y[THETA_], np.nan)
+            model.initial_state(contact, y[STATE:])
+        results[FAILURE_TIME], results[FAILURE_PENETRATION] = t, y[P_]
+        results[FAILURE_LATERAL] = y[Y_]
+    row = record(trajectory, row, writing, t, y, failed)  # the step's end
+    if kind == TURNED_BACK:
+        held = True
+        y[THETA_] = scene.max_obliquity
+    restarted = restarts[kind]
+    if restarted:  # a new right-hand side from here: the stepper starts afresh
+        rates(model, scene, y, failed, held, work.stages[0])
+    ended = outcomes[kind] > 0
+    if ended:
+        results[EXIT_SPEED] = 0.0 if outcomes[kind] == embedment else y[V_]
+        results[EXIT_OBLIQUITY] = np.abs(y[THETA_])
+        results[CONTACT_TIME] = t
+        results[MAX_PENETRATION] = max_penetration
+        counts[OUTCOME] = outcomes[kind]
+    return t, failed, held, max_penetration, row, True, restarted, ended
+
+
 def integrate_scene(
     model: CompiledModel, scene: SceneConstants, tab: Tableau, work: StepWork, ev: EventWork,
     known_margins: Any, y: Any, scale: Any, h_first: float, unit: float, max_steps: int,
@@ -116,61 +187,14 @@ def integrate_scene(
                 copy(margins[0], known_margins)
             else:
                 event_margins(model, scene, samples[j], failed, held, margins[j])
-        event_sigma, kind, crest_sigma = first_event(
-            model, scene, ev, work.coefficients, y, failed, held
-        )
-        hit = np.isfinite(event_sigma)
-        end_sigma = event_sigma if hit else 1.0
-        # Maximum penetration: at the samples inside the step, its end, and the crest.
-        peak = -np.inf
-        for j in range(at.size):
-            if at[j] <= end_sigma:
-                peak = np.maximum(peak, samples[j, P_])
-        if hit:
-            dense_state(work.coefficients, y, end_sigma, ev.state)
-        else:
-            copy(ev.state, work.y_new)
-        peak = np.maximum(peak, ev.state[P_])
-        if crest_sigma < end_sigma:
-            dense_state(work.coefficients, y, crest_sigma, work.trial)
-            peak = np.maximum(peak, work.trial[P_])
-            # the deepest point belongs to the path
-            row = record(trajectory, row, writing, t + crest_sigma * h, work.trial, failed)
-        max_penetration = np.maximum(max_penetration, peak)
-        for j in range(1, at.size):
-            if at[j] < end_sigma:
-                row = record(trajectory, row, writing, t + at[j] * h, samples[j], failed)
-        t = t + end_sigma * h
-        copy(y, ev.state)
-        copy(work.stages[0], work.stages[s])  # the carried derivative (FSAL)
         copy(known_margins, margins[at.size - 1])
-        known = not hit
-        if not hit and tab.branch_landing:  # judge's margins at the step's end: now y's
-            copy(work.margins, work.ahead)
-        margins_known = not hit
-        if not hit:
-            row = record(trajectory, row, writing, t, y, failed)  # the step's end
-            continue
-        if kind == ONSET:
-            failed = True
-            if d > STATE:
-                contact = _contact_of(model, scene, y, y[THETA_], np.nan)
-                model.initial_state(contact, y[STATE:])
-            results[FAILURE_TIME], results[FAILURE_PENETRATION] = t, y[P_]
-            results[FAILURE_LATERAL] = y[Y_]
-        row = record(trajectory, row, writing, t, y, failed)  # the step's end
-        if kind == TURNED_BACK:
-            held = True
-            y[THETA_] = scene.max_obliquity
-        if restarts[kind]:  # a new right-hand side from here: the stepper starts afresh
-            rates(model, scene, y, failed, held, work.stages[0])
-            evaluations += 1
-        if outcomes[kind] > 0:
-            results[EXIT_SPEED] = 0.0 if outcomes[kind] == embedment else y[V_]
-            results[EXIT_OBLIQUITY] = np.abs(y[THETA_])
-            results[CONTACT_TIME] = t
-            results[MAX_PENETRATION] = max_penetration
-            counts[OUTCOME] = outcomes[kind]
+        t, failed, held, max_penetration, row, hit, restarted, ended = settle(
+            model, scene, tab, work, ev, y, h, t, failed, held, max_penetration, row,
+            writing, trajectory, outcomes, restarts, embedment, results, counts,
+        )  # fmt: skip
+        known = margins_known = not hit
+        evaluations += 1 if restarted else 0
+        if ended:
             break
     counts[PLATE_FAILED] = 1 if failed else 0
     counts[STEPS], counts[ACCEPTED], counts[REJECTED] = steps, accepted, rejected
@@ -180,6 +204,6 @@ def integrate_scene(
 
 
 #: The functions of numbers a compiled path compiles.
-KERNELS = (copy, record, integrate_scene)
+KERNELS = (copy, record, settle, integrate_scene)
 #: The kernels that allocate (compiled with reference counting; the rest without).
 ALLOCATING = (scratch,)

@@ -69,19 +69,33 @@ def propose(
     branch_margins(model, scene, work.trial, failed, work.ahead)
     fraction = np.inf
     for r in range(work.margins.size):
-        now, ahead = work.margins[r], work.ahead[r]
-        row_fraction = now / (now - ahead) if now * ahead < 0.0 else np.inf
+        row_fraction = crossing_fraction(work.margins[r], work.ahead[r])
         work.crossing[r] = row_fraction < BRANCH_CROSSING
         fraction = np.minimum(fraction, row_fraction)
     if forced:  # a surface found just ahead by a refused step: crossed now, as judged
         for r in range(work.crossing.size):
             work.crossing[r] = True
-        return h, planned, False
+    h_try, landing = approach(h, fraction, forced)
+    return h_try, planned, landing
+
+
+def crossing_fraction(now: float, ahead: float) -> float:
+    """Where between two points a branch margin changes sign, as a fraction of the way
+    from the first (margins ``now`` and ``ahead`` [m]); inf if it does not."""
+    return now / (now - ahead) if now * ahead < 0.0 else np.inf
+
+
+def approach(h: float, fraction: float, forced: bool) -> tuple[float, bool]:
+    """The step [s] to try for a step ``h`` [s] whose nearest surface is ``fraction`` of
+    the way along it, and whether it lands there (``approach_branches``): across a
+    surface just ahead (or ``forced`` across), onto one further on, else ``h``."""
+    if forced:
+        return h, False
     if fraction < BRANCH_CROSSING:
-        return BRANCH_CROSSING * h, planned, False
+        return BRANCH_CROSSING * h, False
     if fraction < 1.0:
-        return BRANCH_APPROACH * fraction * h, planned, True
-    return h, planned, False
+        return BRANCH_APPROACH * fraction * h, True
+    return h, False
 
 
 def advance(
@@ -125,20 +139,9 @@ def judge(
     norm = 0.0
     for k in range(y.size):
         finite = finite and np.isfinite(work.y_new[k])
-        size = np.maximum(scale[k], np.maximum(np.abs(y[k]), np.abs(work.y_new[k])))
-        ratio = np.abs(work.error[k]) / (tab.rtol * size)
+        ratio = error_ratio(work.error[k], y[k], work.y_new[k], scale[k], tab.rtol)
         norm = ratio if k == 0 else np.maximum(norm, ratio)
-    ok = np.isfinite(norm) and finite and norm <= 1.0
-    factor = np.minimum(
-        np.maximum(SAFETY * np.power(norm, -1.0 / tab.error_order), MIN_FACTOR), MAX_FACTOR
-    )
-    if not np.isfinite(factor):
-        factor = MIN_FACTOR
-    if just_rejected or not ok:
-        factor = np.minimum(factor, 1.0)
-    if tab.branch_landing and landing and ok:  # resume the planned step after landing
-        factor = planned / h
-    h_next = h * factor
+    ok, h_next = next_step(tab, norm, finite, h, planned, landing, just_rejected)
     if not (tab.branch_landing and ok):
         return ok, h_next, not ok, False
     # A step that ended across a surface it did not plan to cross is refused and redone
@@ -153,9 +156,43 @@ def judge(
             where = np.minimum(where, start / (start - end))
     if not crossed:
         return True, h_next, False, False
+    h_again, forced = redo_onto(h, where)
+    return False, h_again, True, forced
+
+
+def error_ratio(error: float, y0: float, y1: float, scale: float, rtol: float) -> float:
+    """A component's error [its unit] over its tolerance, rtol · max(scale, |y0|, |y1|)
+    at the step's two ends (``StepSizes.judge``'s norm, one component)."""
+    size = np.maximum(scale, np.maximum(np.abs(y0), np.abs(y1)))
+    return np.abs(error) / (rtol * size)
+
+
+def next_step(
+    tab: Tableau, norm: float, finite: bool, h: float, planned: float, landing: bool,
+    just_rejected: bool,
+) -> tuple[bool, float]:  # fmt: skip
+    """Whether a step of ``h`` [s] with error ``norm`` (and a finite end) is accepted,
+    and the next step [s] (``StepSizes.judge``)."""
+    ok = np.isfinite(norm) and finite and norm <= 1.0
+    factor = np.minimum(
+        np.maximum(SAFETY * np.power(norm, -1.0 / tab.error_order), MIN_FACTOR), MAX_FACTOR
+    )
+    if not np.isfinite(factor):
+        factor = MIN_FACTOR
+    if just_rejected or not ok:
+        factor = np.minimum(factor, 1.0)
+    if tab.branch_landing and landing and ok:  # resume the planned step after landing
+        factor = planned / h
+    return ok, h * factor
+
+
+def redo_onto(h: float, where: float) -> tuple[float, bool]:
+    """The step [s] that redoes a step ``h`` [s] which crossed a surface it did not plan
+    to, ``where`` of the way along it: onto it, or across it if it lies just ahead (then
+    the next proposal is forced across)."""
     if where < BRANCH_CROSSING:
-        return False, BRANCH_CROSSING * h, True, True
-    return False, BRANCH_APPROACH * where * h, True, False
+        return BRANCH_CROSSING * h, True
+    return BRANCH_APPROACH * where * h, False
 
 
 def dense_coefficients(tab: Tableau, work: StepWork, h: float) -> None:
@@ -187,4 +224,16 @@ def dense_state(coefficients: Any, y0: Any, sigma: float, out: Any) -> None:
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
-KERNELS = (combine, propose, advance, judge, dense_coefficients, dense_state)
+KERNELS = (
+    crossing_fraction,
+    approach,
+    error_ratio,
+    next_step,
+    redo_onto,
+    combine,
+    propose,
+    advance,
+    judge,
+    dense_coefficients,
+    dense_state,
+)

@@ -1,0 +1,145 @@
+"""The right-hand side and the margins of a lane of scenes: :mod:`.motion`'s functions for
+every lane at once, stored lane-major (``src[row, lane]``), calling the same formulas.
+
+Each loop over the lanes calls only inlined, branch-free code (the geometry's eq-6 branch
+and :mod:`plateimpact.elementary`'s functions), so LLVM vectorises it: one pass of eight
+scenes costs about what one scene costs alone. What only some lanes need is then done
+lane by lane by the scalar kernels, which write over the vector results: the failure
+model's terms once the plate has failed, and the turn-around ring of eq 6. A lane's
+numbers are therefore the scalar path's, bit for bit (tested).
+
+``lanes`` is a :class:`~.lanes.Lanes`; ``scenes`` a :class:`~.lanes.Batch` of the batch's
+columns.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...model.events import AT_REST, CONTACT_LOST, ONSET, PERFORATED, TURNED_BACK
+from ...model.geometry import _surface, branch_surfaces, eq6_inclination
+from ...model.resistance import force_from_stress
+from .lane_store import WIDTH, Batch, Lanes, gather, lane_twin, scatter, scene_of
+from .motion import (
+    P_,
+    STATE,
+    THETA_,
+    V_,
+    Y_,
+    CompiledModel,
+    branch_margins,
+    event_margins,
+    kinematic_margins,
+    motion,
+    rates,
+)
+
+# The contact surface, inlined where the vector loop calls it (lane_twin): too large for
+# LLVM's inliner. The small formulas the loops call LLVM inlines itself.
+_eq6_inclination = lane_twin(eq6_inclination)
+_surface_of = lane_twin(_surface)
+
+
+def lane_surfaces(lanes: Lanes, src: Any) -> None:
+    """The contact surface (A, φ, cos ψ, sin ψ, sin θ, cos θ) at every lane's row of
+    ``src`` into ``lanes.surface``, φ from eq 6, and which lanes lie in the ring."""
+    surface, ring = lanes.surface, lanes.ring
+    for lane in range(WIDTH):
+        penetration, obliquity = src[P_, lane], np.abs(src[THETA_, lane])
+        radius = lanes.radius[lane]
+        phi, in_ring = _eq6_inclination(penetration, obliquity, radius)[:2]
+        area, phi, cos_psi, sin_psi, sin_t, cos_t = _surface_of(penetration, obliquity, radius, phi)
+        surface[0, lane], surface[1, lane], surface[2, lane] = area, phi, cos_psi
+        surface[3, lane], surface[4, lane], surface[5, lane] = sin_psi, sin_t, cos_t
+        ring[lane] = in_ring
+
+
+def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any) -> None:
+    """dy/dt at every lane's row of ``src`` into ``out`` (:func:`~.motion.rates`)."""
+    lane_surfaces(lanes, src)
+    surface, stress = lanes.surface, lanes.stress
+    # The law's stress one lane at a time: its constants are the scene's row.
+    for lane in range(WIDTH):
+        i = lanes.scene[lane]
+        if i >= 0:
+            incidence = np.abs(src[THETA_, lane]) - surface[1, lane]
+            stress[lane] = model.stress(src[V_, lane], incidence, scenes.law_constants[i])
+    for lane in range(WIDTH):
+        theta, speed = src[THETA_, lane], src[V_, lane]
+        side = -1.0 if theta < 0.0 else 1.0
+        here = (
+            surface[0, lane], surface[1, lane], surface[2, lane], surface[3, lane],
+            surface[4, lane], surface[5, lane],
+        )  # fmt: skip
+        drag, lift = force_from_stress(here, stress[lane])
+        p_rate, y_rate, theta_rate, v_rate = motion(
+            here, drag, lift, side, speed, lanes.mass[lane], lanes.held[lane]
+        )
+        out[P_, lane], out[Y_, lane], out[THETA_, lane], out[V_, lane] = (
+            p_rate,
+            y_rate,
+            theta_rate,
+            v_rate,
+        )
+    for row in range(STATE, out.shape[0]):
+        for lane in range(WIDTH):
+            out[row, lane] = 0.0
+    for lane in range(WIDTH):
+        i = lanes.scene[lane]
+        if i >= 0 and (lanes.ring[lane] or lanes.failed[lane]):
+            y, rate = gather(src, lane, lanes.one_state), lanes.one_rate
+            rates(model, scene_of(scenes, i), y, lanes.failed[lane], lanes.held[lane], rate)
+            scatter(rate, out, lane)
+
+
+def lane_branch_margins(
+    model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any
+) -> None:
+    """The branch margins at every lane's row of ``src`` into ``out`` (rows, lanes)
+    (:func:`~.motion.branch_margins`)."""
+    for lane in range(WIDTH):
+        first, second = branch_surfaces(
+            src[P_, lane], np.abs(src[THETA_, lane]), lanes.radius[lane]
+        )
+        out[0, lane], out[1, lane] = first, second
+    for row in range(2, out.shape[0]):
+        for lane in range(WIDTH):
+            out[row, lane] = np.nan
+    if out.shape[0] > 2:
+        for lane in range(WIDTH):
+            i = lanes.scene[lane]
+            if i >= 0 and lanes.failed[lane]:
+                y, margins = gather(src, lane, lanes.one_state), lanes.one_branch
+                branch_margins(model, scene_of(scenes, i), y, True, margins)
+                scatter(margins, out, lane)
+
+
+def lane_event_margins(
+    model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any
+) -> None:
+    """The event margins at every lane's row of ``src`` into ``out`` (events, lanes)
+    (:func:`~.motion.event_margins`)."""
+    for lane in range(WIDTH):
+        onset, lost, rest, back = kinematic_margins(
+            src[P_, lane], np.abs(src[THETA_, lane]), src[V_, lane], lanes.radius[lane],
+            lanes.rest_speed[lane], lanes.onset_penetration[lane], scenes.turn_back_limit,
+            scenes.adds_onset, lanes.failed[lane], lanes.held[lane],
+        )  # fmt: skip
+        out[ONSET, lane], out[CONTACT_LOST, lane] = onset, lost
+        out[AT_REST, lane], out[TURNED_BACK, lane] = rest, back
+        out[PERFORATED, lane] = -np.inf
+    if scenes.adds_perforation:
+        for lane in range(WIDTH):
+            i = lanes.scene[lane]
+            if i >= 0 and lanes.failed[lane]:
+                y, margins = gather(src, lane, lanes.one_state), lanes.one_event
+                event_margins(model, scene_of(scenes, i), y, True, lanes.held[lane], margins)
+                scatter(margins, out, lane)
+
+
+#: The functions of numbers a compiled path compiles (callees before callers).
+KERNELS = (lane_surfaces, lane_rates, lane_branch_margins, lane_event_margins)
+#: Inlined where called.
+INLINE = (_eq6_inclination, _surface_of)
