@@ -22,7 +22,6 @@ from .report.constants import CRITICAL_PENETRATION, FAILURE_ANGLE
 from .separation import (
     PlaneSeparation,
     separation_branch_margins,
-    separation_force_change,
     separation_perforation_margin,
 )
 
@@ -120,16 +119,16 @@ def finger_rate_kernel(
 _DEPTH, _THETA1, _OPENING, _ALPHA, _SCALE = range(5)
 
 
-def hinge_force_change(contact: KernelContact) -> tuple[float, float]:
-    """:meth:`Hinge.force_change` of one scene: the relief and the finger (eqs 15-21)."""
+def finger_force(contact: KernelContact) -> tuple[float, float]:
+    """The finger's drag and lift [N] (eqs 16-21): :meth:`Hinge.force_change` of one
+    scene besides the relief (``relief_column``)."""
     c = contact.constants
-    drag, lift = separation_force_change(contact)
     area, incidence = finger_kernel(
         contact.obliquity, contact.failure_state[0], contact.radius, c[_THETA1], c[_OPENING],
         c[_SCALE],
     )  # fmt: skip
-    finger_force = area * kernels.law_stress(contact.speed, incidence, contact)  # eq 16
-    return drag + finger_force * np.cos(incidence), lift + finger_force * np.sin(incidence)
+    force = area * kernels.law_stress(contact.speed, incidence, contact)  # eq 16
+    return force * np.cos(incidence), force * np.sin(incidence)
 
 
 def hinge_branch_margins(contact: KernelContact, out: Any) -> None:
@@ -165,7 +164,7 @@ KERNELS = (
     finger_is_held,
     peeling_rate,
     finger_rate_kernel,
-    hinge_force_change,
+    finger_force,
     hinge_branch_margins,
     hinge_initial_state,
     hinge_state_rates,
@@ -217,12 +216,13 @@ class Hinge(PlaneSeparation):
     )
 
     kernels = FailureKernels(
-        hinge_force_change,
+        finger_force,
         separation_perforation_margin,
         branch_rows=4,
         branch_margins=hinge_branch_margins,
         initial_state=hinge_initial_state,
         state_rates=hinge_state_rates,
+        relief_column=_DEPTH,
     )
 
     finger_area_scale: float = FINGER_AREA_SCALE.field()

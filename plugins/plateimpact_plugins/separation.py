@@ -41,15 +41,6 @@ def plane_branch_surfaces(
     return geometry.branch_surfaces(penetration - plane_depth, obliquity, radius)
 
 
-def separation_force_change(contact: KernelContact) -> tuple[float, float]:
-    """:meth:`PlaneSeparation.force_change` of one scene (``contact.constants[0]``: h)."""
-    depth = contact.constants[0]
-    relieved_drag, relieved_lift = kernels.law_force(
-        contact.penetration - depth, contact.obliquity, contact.speed, contact
-    )
-    return -relieved_drag, -relieved_lift
-
-
 def separation_perforation_margin(contact: KernelContact) -> float:
     """:meth:`PlaneSeparation.perforation_margin` of one scene [m]."""
     return plane_perforation_margin(
@@ -69,7 +60,6 @@ KERNELS = (
     failure_plane_depth,
     plane_perforation_margin,
     plane_branch_surfaces,
-    separation_force_change,
     separation_perforation_margin,
     separation_branch_margins,
 )
@@ -99,10 +89,11 @@ class PlaneSeparation(FailureModel):
     )
     kernel_columns: ClassVar[tuple[str, ...]] = ("failure_plane_depth",)
     kernels: ClassVar[FailureKernels | None] = FailureKernels(
-        separation_force_change,
+        kernels.no_force_change,  # the relief is all (relief_column)
         separation_perforation_margin,
         branch_rows=2,
         branch_margins=separation_branch_margins,
+        relief_column=0,  # failure_plane_depth
     )
 
     @abstractmethod
@@ -116,7 +107,7 @@ class PlaneSeparation(FailureModel):
     def relief(self, contact: Contact) -> tuple[np.ndarray, np.ndarray]:
         """−F′ as (drag, lift) [N]: the force no longer exerted beyond the plane (eq 15)."""
         # F′: the law on the contact surface below the plane, eqs 2–6 with P − h for P
-        # (the kernel twin: separation_force_change)
+        # (compiled: FailureKernels.relief_column, the same formulas)
         depth = contact.scenes.failure_plane_depth
         relieved_drag, relieved_lift = contact.law.contact_force(
             contact.penetration - depth, contact.obliquity, contact.speed

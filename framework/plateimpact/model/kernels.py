@@ -88,6 +88,11 @@ def no_state_rates(contact: KernelContact, out: Any) -> None:
         out[row] = 0.0
 
 
+def no_force_change(contact: KernelContact) -> tuple[float, float]:
+    """No force besides the relief (drag, lift [N]): a plugging plate's ``force_change``."""
+    return 0.0, 0.0
+
+
 class FailureKernels(NamedTuple):
     """A failure model's methods as kernels of one :class:`KernelContact`: the same
     formulas as its numpy methods, for the compiled path.
@@ -96,6 +101,13 @@ class FailureKernels(NamedTuple):
     [m]``; ``branch_margins(contact, out)`` writes its ``branch_rows`` margins into
     ``out``; ``initial_state(contact, out)`` and ``state_rates(contact, out)`` write the
     state at onset and its rates [unit/s] (``contact.obliquity_rate`` known there).
+
+    ``relief_column``: where the plate separates along a plane (eqs 8–15), the row of
+    ``kernel_constants`` holding its depth h [m]. The force change is then −F′, the
+    resistance law's force on the contact surface below that plane, plus what
+    ``force_change`` returns besides (the hinge's finger; :func:`no_force_change` for a
+    plugging plate): the compiled path evaluates F′ for lanes of scenes together, as it
+    does the intact force. −1 (the default): ``force_change`` is the whole change.
     """
 
     force_change: Callable[..., tuple[float, float]]
@@ -104,6 +116,7 @@ class FailureKernels(NamedTuple):
     branch_margins: Callable[..., None] = no_branch_margins
     initial_state: Callable[..., None] = no_initial_state
     state_rates: Callable[..., None] = no_state_rates
+    relief_column: int = -1
 
     def functions(self) -> tuple[Callable[..., Any], ...]:
         """The kernels, for the compiled path to compile."""
@@ -117,4 +130,11 @@ class FailureKernels(NamedTuple):
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
-KERNELS = (law_stress, law_force, no_branch_margins, no_initial_state, no_state_rates)
+KERNELS = (
+    law_stress,
+    law_force,
+    no_branch_margins,
+    no_initial_state,
+    no_state_rates,
+    no_force_change,
+)

@@ -25,7 +25,7 @@ def signature_arguments() -> tuple[np.ndarray, ...]:
     return (
         np.empty((0, 6)), np.empty((0, 4)), np.empty((0, 4)), np.empty((0, 1)),
         np.empty((0, 2)), np.empty(1), np.empty((1, 1)), np.empty(1), np.empty(1),
-        np.empty((1, 1)), np.zeros(5), np.zeros(8, np.int64), np.zeros(events, np.int64),
+        np.empty((1, 1)), np.zeros(5), np.zeros(10, np.int64), np.zeros(events, np.int64),
         np.zeros(events, np.bool_), np.empty((0, scene.FLOAT_RESULTS)),
         np.empty((0, scene.COUNTS), np.int64), np.empty((0, 6)), np.empty(0, np.int64),
     )  # fmt: skip

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from ...model import kernels
 from ...model.binding import BoundBatch
 from ...model.events import EVENTS, FAILURE_ONSET, PERFORATION
 from ...model.impact import KINEMATIC_STATE, OBLIQUITY, SPEED, ImpactModel
@@ -102,7 +103,8 @@ def integrate_compiled(
     ints = np.array(
         [control.branch_landing, *adds, integrator.max_steps,
          2 + failure_kernels.branch_rows, Outcome.EMBEDMENT, integrator.event_samples,
-         0],
+         0, failure_kernels.relief_column,
+         failure_kernels.force_change is not kernels.no_force_change],
         dtype=np.int64,
     )  # fmt: skip
     outcomes = np.array([0 if e.outcome is None else int(e.outcome) for e in EVENTS], np.int64)
@@ -130,7 +132,7 @@ def integrate_compiled(
         first_rows = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
         trajectory = np.empty((int(sizes.sum()), 2 + width))
         writing = ints.copy()
-        writing[-1] = 1
+        writing[7] = 1
         again = (np.empty_like(results), np.empty_like(counts))
         second = arguments_with(initial, writing, *again, trajectory, first_rows)
         run_parallel(compiled.run, n, second)

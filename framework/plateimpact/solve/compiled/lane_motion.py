@@ -30,6 +30,7 @@ from .motion import (
     Y_,
     CompiledModel,
     branch_margins,
+    contact_of,
     event_margins,
     kinematic_margins,
     motion,
@@ -42,13 +43,14 @@ _eq6_inclination = lane_twin(eq6_inclination)
 _surface_of = lane_twin(_surface)
 
 
-def lane_surfaces(lanes: Lanes, src: Any) -> None:
-    """The contact surface (A, φ, cos ψ, sin ψ, sin θ, cos θ) at every lane's row of
-    ``src`` into ``lanes.surface``, φ from eq 6, and which lanes lie in the ring."""
-    surface, ring = lanes.surface, lanes.ring
+def lane_surfaces(lanes: Lanes, src: Any, depth: Any, surface: Any, ring: Any) -> None:
+    """The contact surface (A, φ, cos ψ, sin ψ, sin θ, cos θ) below the plane ``depth``
+    [m] above each lane's deepest point (P − depth for P: 0 for the intact surface, the
+    failure plane's depth for the relieved one) at every lane's row of ``src``, into
+    ``surface`` (6, lanes), φ from eq 6, and which lanes lie in the ring instead."""
     for lane in range(WIDTH):
-        penetration, obliquity = src[P_, lane], np.abs(src[THETA_, lane])
-        radius = lanes.radius[lane]
+        penetration = src[P_, lane] - depth[lane]
+        obliquity, radius = np.abs(src[THETA_, lane]), lanes.radius[lane]
         phi, in_ring = _eq6_inclination(penetration, obliquity, radius)[:2]
         area, phi, cos_psi, sin_psi, sin_t, cos_t = _surface_of(penetration, obliquity, radius, phi)
         surface[0, lane], surface[1, lane], surface[2, lane] = area, phi, cos_psi
@@ -56,16 +58,68 @@ def lane_surfaces(lanes: Lanes, src: Any) -> None:
         ring[lane] = in_ring
 
 
-def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any) -> None:
-    """dy/dt at every lane's row of ``src`` into ``out`` (:func:`~.motion.rates`)."""
-    lane_surfaces(lanes, src)
-    surface, stress = lanes.surface, lanes.stress
-    # The law's stress one lane at a time: its constants are the scene's row.
+def lane_forces(
+    model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, surface: Any,
+    only_failed: bool, drag: Any, lift: Any,
+) -> None:  # fmt: skip
+    """The law's drag and lift [N] on each lane's ``surface`` (:func:`force_on_surface`):
+    the stress one lane at a time (its constants are the scene's row), the force as a
+    vector. ``only_failed``: the stress only where the plate has failed."""
+    stress = lanes.stress
     for lane in range(WIDTH):
         i = lanes.scene[lane]
-        if i >= 0:
+        if i >= 0 and (lanes.failed[lane] or not only_failed):
             incidence = np.abs(src[THETA_, lane]) - surface[1, lane]
             stress[lane] = model.stress(src[V_, lane], incidence, scenes.law_constants[i])
+    for lane in range(WIDTH):
+        here = (
+            surface[0, lane], surface[1, lane], surface[2, lane], surface[3, lane],
+            surface[4, lane], surface[5, lane],
+        )  # fmt: skip
+        drag[lane], lift[lane] = force_from_stress(here, stress[lane])
+
+
+def lane_failure_forces(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any) -> None:
+    """Each failed lane's change of drag and lift (:func:`~.motion.failure_force`) added
+    to ``lanes.drag`` and ``lanes.lift``: −F′ below the relief plane for every lane
+    together, what ``force_change`` adds lane by lane."""
+    extra_drag, extra_lift = lanes.extra_drag, lanes.extra_lift
+    relief = model.relief_column >= 0
+    if relief:
+        lane_surfaces(lanes, src, lanes.depth, lanes.relieved, lanes.relieved_ring)
+        lane_forces(model, lanes, scenes, src, lanes.relieved, True, extra_drag, extra_lift)
+        for lane in range(WIDTH):
+            extra_drag[lane], extra_lift[lane] = -extra_drag[lane], -extra_lift[lane]  # eq 15
+    if model.force_besides_relief or not relief:
+        for lane in range(WIDTH):
+            i = lanes.scene[lane]
+            if i >= 0 and lanes.failed[lane]:
+                y = gather(src, lane, lanes.one_state)
+                contact = contact_of(model, scene_of(scenes, i), y, np.abs(y[THETA_]), np.nan)
+                more_drag, more_lift = model.force_change(contact)
+                if relief:
+                    more_drag, more_lift = (
+                        extra_drag[lane] + more_drag,
+                        extra_lift[lane] + more_lift,
+                    )
+                extra_drag[lane], extra_lift[lane] = more_drag, more_lift
+    drag, lift = lanes.drag, lanes.lift
+    for lane in range(WIDTH):
+        failed = lanes.failed[lane]
+        drag[lane] = drag[lane] + extra_drag[lane] if failed else drag[lane]
+        lift[lane] = lift[lane] + extra_lift[lane] if failed else lift[lane]
+
+
+def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any) -> None:
+    """dy/dt at every lane's row of ``src`` into ``out`` (:func:`~.motion.rates`)."""
+    surface, drag, lift = lanes.surface, lanes.drag, lanes.lift
+    lane_surfaces(lanes, src, lanes.no_depth, surface, lanes.ring)
+    lane_forces(model, lanes, scenes, src, surface, False, drag, lift)
+    any_failed = False
+    for lane in range(WIDTH):
+        any_failed = any_failed | (lanes.failed[lane] & (lanes.scene[lane] >= 0))
+    if any_failed:
+        lane_failure_forces(model, lanes, scenes, src)
     for lane in range(WIDTH):
         theta, speed = src[THETA_, lane], src[V_, lane]
         side = -1.0 if theta < 0.0 else 1.0
@@ -73,25 +127,33 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
             surface[0, lane], surface[1, lane], surface[2, lane], surface[3, lane],
             surface[4, lane], surface[5, lane],
         )  # fmt: skip
-        drag, lift = force_from_stress(here, stress[lane])
         p_rate, y_rate, theta_rate, v_rate = motion(
-            here, drag, lift, side, speed, lanes.mass[lane], lanes.held[lane]
+            here, drag[lane], lift[lane], side, speed, lanes.mass[lane], lanes.held[lane]
         )
-        out[P_, lane], out[Y_, lane], out[THETA_, lane], out[V_, lane] = (
-            p_rate,
-            y_rate,
-            theta_rate,
-            v_rate,
-        )
+        out[P_, lane], out[Y_, lane] = p_rate, y_rate
+        out[THETA_, lane], out[V_, lane] = theta_rate, v_rate
     for row in range(STATE, out.shape[0]):
         for lane in range(WIDTH):
             out[row, lane] = 0.0
+    relief = model.relief_column >= 0
     for lane in range(WIDTH):
         i = lanes.scene[lane]
-        if i >= 0 and (lanes.ring[lane] or lanes.failed[lane]):
+        if i < 0:
+            continue
+        failed = lanes.failed[lane]
+        if lanes.ring[lane] or (failed and relief and lanes.relieved_ring[lane]):
             y, rate = gather(src, lane, lanes.one_state), lanes.one_rate
-            rates(model, scene_of(scenes, i), y, lanes.failed[lane], lanes.held[lane], rate)
+            rates(model, scene_of(scenes, i), y, failed, lanes.held[lane], rate)
             scatter(rate, out, lane)
+        elif failed and out.shape[0] > STATE:  # the failure state's rates
+            y, rate = gather(src, lane, lanes.one_state), lanes.one_rate
+            side = -1.0 if y[THETA_] < 0.0 else 1.0
+            contact = contact_of(
+                model, scene_of(scenes, i), y, side * y[THETA_], side * out[THETA_, lane]
+            )
+            model.state_rates(contact, rate[STATE:])
+            for row in range(STATE, out.shape[0]):
+                out[row, lane] = rate[row]
 
 
 def lane_branch_margins(
@@ -140,6 +202,13 @@ def lane_event_margins(
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
-KERNELS = (lane_surfaces, lane_rates, lane_branch_margins, lane_event_margins)
+KERNELS = (
+    lane_surfaces,
+    lane_forces,
+    lane_failure_forces,
+    lane_rates,
+    lane_branch_margins,
+    lane_event_margins,
+)
 #: Inlined where called.
 INLINE = (_eq6_inclination, _surface_of)

@@ -77,6 +77,14 @@ class Lanes(NamedTuple):
     surface: Any
     ring: Any
     stress: Any
+    drag: Any
+    lift: Any
+    depth: Any
+    no_depth: Any
+    relieved: Any
+    relieved_ring: Any
+    extra_drag: Any
+    extra_lift: Any
     t: Any
     h: Any
     h_next: Any
@@ -130,7 +138,10 @@ def lanes_scratch(
         np.zeros((s + 1, width, n)), np.zeros((q, width, n)), np.zeros((branch_rows, n)),
         np.zeros((branch_rows, n)), np.zeros((branch_rows, n), np.bool_),
         np.zeros((at.size, width, n)), np.zeros((at.size, events, n)), np.zeros((6, n)),
-        np.zeros(n, np.bool_), zeros.copy(), zeros.copy(), ones.copy(), ones.copy(),
+        np.zeros(n, np.bool_), zeros.copy(),
+        zeros.copy(), zeros.copy(), zeros.copy(), zeros.copy(), np.zeros((6, n)),
+        np.zeros(n, np.bool_), zeros.copy(), zeros.copy(),
+        zeros.copy(), ones.copy(), ones.copy(),
         ones.copy(), zeros.copy(), zeros.copy(), zeros.copy(), zeros.copy(),
         flags[0], flags[1], flags[2], flags[3], flags[4], flags[5], flags[6], flags[7],
         flags[8], flags[9], np.zeros((5, n), np.int64), np.zeros(width), np.zeros(width),

@@ -57,6 +57,8 @@ def enter(
     lanes.radius[lane], lanes.mass[lane] = core[i, 0], core[i, 1]
     lanes.rest_speed[lane], lanes.onset_penetration[lane] = core[i, 2], core[i, 3]
     lanes.h_next[lane], lanes.unit[lane] = core[i, 4], core[i, 5]
+    column = model.relief_column
+    lanes.depth[lane] = scenes.constants[i, column] if column >= 0 else 0.0
     scatter(scenes.y[i], lanes.y, lane)
     scatter(scenes.scale[i], lanes.scale, lane)
     lanes.t[lane], lanes.max_penetration[lane] = 0.0, 0.0

@@ -16,14 +16,15 @@ import numpy as np
 from ...model.events import AT_REST, CONTACT_LOST, ONSET, PERFORATED, TURNED_BACK
 from ...model.geometry import HALF_PI, branch_surfaces, contact_lost_margin, contact_surface_kernel
 from ...model.kernels import KernelContact
-from ...model.resistance import force_on_surface
+from ...model.resistance import force_on_contact, force_on_surface
 
 P_, Y_, THETA_, V_ = 0, 1, 2, 3  # rows of y (plateimpact.model.impact.PENETRATION ...)
 STATE = 4  # first failure-state row (KINEMATIC_STATE)
 
 
 class CompiledModel(NamedTuple):
-    """The plug-ins' kernels: the law's stress, the failure model's :class:`FailureKernels`."""
+    """The plug-ins' kernels: the law's stress, the failure model's :class:`FailureKernels`
+    (its ``relief_column``, and whether its ``force_change`` adds anything to a relief)."""
 
     stress: Any
     force_change: Any
@@ -31,6 +32,8 @@ class CompiledModel(NamedTuple):
     branch_margins: Any
     initial_state: Any
     state_rates: Any
+    relief_column: int
+    force_besides_relief: bool
 
 
 class SceneConstants(NamedTuple):
@@ -60,6 +63,25 @@ def contact_of(
     )  # fmt: skip
 
 
+def failure_force(
+    model: CompiledModel, scene: SceneConstants, y: Any, obliquity: float
+) -> tuple[float, float]:
+    """The failure model's change of drag and lift [N] at ``y``, at |θ| = ``obliquity``
+    [rad] (its ``force_change``): −F′ below its relief plane if it declares one (eqs
+    9–15), plus its ``force_change``."""
+    if model.relief_column < 0:
+        return model.force_change(contact_of(model, scene, y, obliquity, np.nan))
+    depth = scene.constants[model.relief_column]
+    relieved_drag, relieved_lift = force_on_contact(
+        y[P_] - depth, obliquity, y[V_], scene.radius, contact_surface_kernel, model.stress,
+        scene.law_constants,
+    )  # fmt: skip
+    if not model.force_besides_relief:
+        return -relieved_drag, -relieved_lift  # eq 15
+    extra_drag, extra_lift = model.force_change(contact_of(model, scene, y, obliquity, np.nan))
+    return -relieved_drag + extra_drag, -relieved_lift + extra_lift
+
+
 def motion(
     surface: Any, drag: float, lift: float, side: float, speed: float, mass: float, held: bool
 ) -> tuple[float, float, float, float]:
@@ -82,7 +104,7 @@ def rates(
     surface = contact_surface_kernel(y[P_], obliquity, scene.radius)
     drag, lift = force_on_surface(surface, obliquity, speed, model.stress, scene.law_constants)
     if failed:
-        extra_drag, extra_lift = model.force_change(contact_of(model, scene, y, obliquity, np.nan))
+        extra_drag, extra_lift = failure_force(model, scene, y, obliquity)
         drag, lift = drag + extra_drag, lift + extra_lift
     out[P_], out[Y_], out[THETA_], out[V_] = motion(
         surface, drag, lift, side, speed, scene.mass, held
@@ -139,4 +161,12 @@ def branch_margins(
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
-KERNELS = (contact_of, motion, rates, kinematic_margins, event_margins, branch_margins)
+KERNELS = (
+    contact_of,
+    failure_force,
+    motion,
+    rates,
+    kinematic_margins,
+    event_margins,
+    branch_margins,
+)

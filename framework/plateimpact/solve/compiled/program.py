@@ -68,7 +68,7 @@ from plateimpact.solve.compiled.stepping import Tableau
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, floats, ints,
         outcomes, restarts, results, counts, trajectory, first_rows):
-    model = CompiledModel({slots})
+    model = CompiledModel({slots}, ints[8], ints[9] != 0)
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
     scenes = lane_store.Batch(
         core, y, scale, constants, law_constants, floats[3], floats[4], ints[1] != 0,
@@ -85,7 +85,7 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
 def run_one_at_a_time(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P,
                       floats, ints, outcomes, restarts, results, counts, trajectory,
                       first_rows):
-    model = CompiledModel({slots})
+    model = CompiledModel({slots}, ints[8], ints[9] != 0)
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
     work, ev, known_margins = scene.scratch(tab, y.shape[1], ints[4], ints[6], outcomes.size)
     for i in range(start, stop):
