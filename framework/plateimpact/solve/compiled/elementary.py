@@ -73,7 +73,7 @@ def _llvm_sqrt(typingctx: Any, x: Any) -> Any:
 @register_jitable(_nrt=False)
 def sqrt_branch_free(x: float) -> float:
     """√x [NaN for x < 0]."""
-    return _llvm_sqrt(x)  # type: ignore[call-arg]  # numba passes the typing context
+    return _llvm_sqrt(x)  # type: ignore[call-arg,unused-ignore]  # numba adds the typing context
 
 
 @register_jitable(_nrt=False)
