@@ -2,14 +2,16 @@
 every lane at once, stored lane-major (``src[row, lane]``), calling the same formulas.
 
 Each loop over the lanes calls only inlined, branch-free code (the geometry's eq-6 branch
-and :mod:`plateimpact.elementary`'s functions), so LLVM vectorises it: one pass of eight
-scenes costs about what one scene costs alone. What only some lanes need is then done
-lane by lane by the scalar kernels, which write over the vector results: the failure
-model's terms once the plate has failed, and the turn-around ring of eq 6. A lane's
-numbers are therefore the scalar path's, bit for bit (tested).
+and :mod:`plateimpact.elementary`'s functions), so LLVM vectorises it: a pass over the
+16 lanes costs a few scenes' worth. The relieved force of a failed plate (eqs 9–15) is a
+second such pass. What only some lanes need is then done lane by lane by the scalar
+kernels: the law's stress (its constants are the scene's row), what a failure model adds
+on top of its relief, the failure state's rates, and the turn-around ring of eq 6, which
+the scalar rates redo whole. A lane's numbers are therefore the scalar path's, bit for
+bit (tested).
 
-``lanes`` is a :class:`~.lanes.Lanes`; ``scenes`` a :class:`~.lanes.Batch` of the batch's
-columns.
+``lanes`` is a :class:`~.lane_store.Lanes`; ``scenes`` a :class:`~.lane_store.Batch` of
+the batch's columns.
 """
 
 from __future__ import annotations
