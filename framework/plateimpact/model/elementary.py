@@ -1,7 +1,7 @@
 """The elementary functions the formulas call: √, arccos, sin, cos, and sin and cos at once.
 
 On numbers and arrays in Python (the numpy path) they are numpy's ufuncs. Compiled code
-calls branch-free polynomial versions instead (:mod:`plateimpact.solve.compiled.elementary`,
+calls branch-free polynomial versions instead (``plateimpact.solve.compiled.elementary``,
 fdlibm's coefficients, within an ulp or two of numpy's): a loop over scenes that calls the
 C library's ``acos`` or ``sincos`` cannot be vectorised, one that evaluates polynomials
 can, so lanes of scenes evaluate their forces in one SIMD pass (docs/integrators.md,
@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 #: The implementations on arrays: numpy's ufuncs, unless replaced by the compiled
-#: path's own (:func:`plateimpact.solve.compiled.elementary.in_numpy_path`, which the
+#: path's own (``plateimpact.solve.compiled.elementary.in_numpy_path()``, which the
 #: tests use to compare the two paths with the same functions).
 IMPLEMENTATIONS: dict[str, Any] = {"arccos": np.arccos, "sin": np.sin, "cos": np.cos}
 

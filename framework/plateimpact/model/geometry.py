@@ -15,11 +15,11 @@ compiles it for a per-scene loop, the compiled path) with the same results. Wher
 formula switches branch per scene (the turn-around ring of eq 6), an array function
 selects with a mask and a ``*_kernel`` twin with an ``if``, both calling the same
 formulas; :data:`KERNELS` lists what a compiled path compiles. Square roots, sines,
-cosines and arccos come from :mod:`.elementary` (numpy's on arrays, branch-free
-polynomials when compiled, so that lanes of scenes vectorise). All arccos/arcsin
-arguments are clamped to [−1, 1]: they leave it in legitimate states (docs/model.md §2,
-"Clamps"), and the clamped values are the report's own special cases ("then Γe = 2π",
-"then Γs = 0").
+cosines and arccos come from :mod:`plateimpact.model.elementary` (numpy's on arrays,
+branch-free polynomials when compiled, so that lanes of scenes vectorise). All
+arccos/arcsin arguments are clamped to [−1, 1]: they leave it in legitimate states
+(docs/model.md §2, "Clamps"), and the clamped values are the report's own special cases
+("then Γe = 2π", "then Γs = 0").
 For the plugging relief (eqs 9–13), call the same functions with P − h in place of P.
 """
 
