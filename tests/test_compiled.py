@@ -19,6 +19,7 @@ import sys
 import warnings
 from pathlib import Path
 
+import attrs
 import numpy as np
 import pytest
 
@@ -160,6 +161,21 @@ def test_lanes_give_what_one_scene_at_a_time_gives_bit_for_bit(monkeypatch):
         a, b = lanes.trajectory_of(i), alone.trajectory_of(i)
         for name in ("time", "penetration", "lateral", "obliquity", "speed"):
             np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+@pytest.mark.parametrize("column", [1, -2, 0.0])
+def test_a_relief_plane_outside_the_kernel_constants_is_one_plugin_error(column):
+    """Compiled code reads a declared relief plane's row unchecked, so a plug-in whose
+    ``relief_column`` is not a row of its kernel constants (plugging has one row) is
+    refused before any scene runs, in one line naming the field and the range."""
+    from plateimpact_plugins.plugging import Plugging  # noqa: PLC0415
+
+    kernels = Plugging.kernels._replace(relief_column=column)
+    broken = type("BrokenRelief", (Plugging,), {"kernels": kernels, "name": "broken-relief"})
+    simulation = pi.Simulation.from_names(failure="plugging", engine="compiled")
+    simulation = attrs.evolve(simulation, model=attrs.evolve(simulation.model, failure=broken()))
+    with pytest.raises(pi.PluginError, match=r"relief_column=.* \(0 to 0, or -1"):
+        simulation.run_batch(batch(12))
 
 
 def test_auto_runs_compiled_whatever_the_size_and_chunking_changes_nothing():

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from ...base.errors import PluginError
 from ...model import kernels
 from ...model.binding import BoundBatch
 from ...model.events import EVENTS, FAILURE_ONSET, PERFORATION
@@ -67,6 +68,18 @@ def unavailable_reason(model: ImpactModel, integrator: Integrator) -> str | None
     return None
 
 
+def _check_relief(model: ImpactModel, column: object, rows: int) -> None:
+    """A declared relief plane must be a row of the model's kernel constants: compiled
+    code reads the row without a bounds check."""
+    if isinstance(column, (int, np.integer)) and not isinstance(column, bool):
+        if column == -1 or 0 <= column < rows:
+            return
+    raise PluginError(
+        f"failure {model.failure.name!r}: FailureKernels.relief_column={column!r} is not a "
+        f"row of its kernel_constants (0 to {rows - 1}, or -1 for no relief plane)"
+    )
+
+
 def integrate_compiled(
     model: ImpactModel, integrator: Integrator, batch: BoundBatch, recorder: ResultRecorder
 ) -> None:
@@ -92,6 +105,7 @@ def integrate_compiled(
     y[:, KINEMATIC_STATE:] = model.new_failure_state(n).T
     scale = np.ascontiguousarray(dynamics.component_scale(width).T)
     constants = np.ascontiguousarray(model.failure.kernel_constants(batch.failure).T, float)
+    _check_relief(model, failure_kernels.relief_column, constants.shape[1])
     law_constants = np.ascontiguousarray(
         model.resistance.kernel_constants(batch.resistance).T, float
     )
