@@ -31,7 +31,8 @@ from plateimpact.model.geometry import (
     presented_area,
     ring_inclination,
 )
-from plateimpact.model.resistance import force_on_contact, force_on_surface
+from plateimpact.model.resistance import force_from_stress, force_on_contact, force_on_surface
+from plateimpact.solve.compiled import elementary  # noqa: F401  (registers the branch-free functions)
 from plateimpact_plugins.dopri5 import DormandPrince54
 from plateimpact_plugins.poncelet import poncelet_stress
 
@@ -43,6 +44,7 @@ def stress_of_pair(speed, incidence, pair):
 
 for _kernel in (
     *geometry.KERNELS,
+    force_from_stress,
     force_on_surface,
     force_on_contact,
     poncelet_stress,
