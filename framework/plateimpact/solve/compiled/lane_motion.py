@@ -34,6 +34,7 @@ from .motion import (
     branch_margins,
     contact_of,
     event_margins,
+    failure_state_rates,
     kinematic_margins,
     motion,
     rates,
@@ -43,6 +44,15 @@ from .motion import (
 # LLVM's inliner. The small formulas the loops call LLVM inlines itself.
 _eq6_inclination = lane_twin(eq6_inclination)
 _surface_of = lane_twin(_surface)
+
+
+def surface_of_lane(surface: Any, lane: int) -> tuple[float, ...]:
+    """One lane's contact surface (A, φ, cos ψ, sin ψ, sin θ, cos θ) from ``surface``
+    (6, lanes), as the scalar formulas take it."""
+    return (
+        surface[0, lane], surface[1, lane], surface[2, lane], surface[3, lane],
+        surface[4, lane], surface[5, lane],
+    )  # fmt: skip
 
 
 def lane_surfaces(lanes: Lanes, src: Any, depth: Any, surface: Any, ring: Any) -> None:
@@ -74,10 +84,7 @@ def lane_forces(
             incidence = np.abs(src[THETA_, lane]) - surface[1, lane]
             stress[lane] = model.stress(src[V_, lane], incidence, scenes.law_constants[i])
     for lane in range(WIDTH):
-        here = (
-            surface[0, lane], surface[1, lane], surface[2, lane], surface[3, lane],
-            surface[4, lane], surface[5, lane],
-        )  # fmt: skip
+        here = surface_of_lane(surface, lane)
         drag[lane], lift[lane] = force_from_stress(here, stress[lane])
 
 
@@ -125,10 +132,7 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
     for lane in range(WIDTH):
         theta, speed = src[THETA_, lane], src[V_, lane]
         side = -1.0 if theta < 0.0 else 1.0
-        here = (
-            surface[0, lane], surface[1, lane], surface[2, lane], surface[3, lane],
-            surface[4, lane], surface[5, lane],
-        )  # fmt: skip
+        here = surface_of_lane(surface, lane)
         p_rate, y_rate, theta_rate, v_rate = motion(
             here, drag[lane], lift[lane], side, speed, lanes.mass[lane], lanes.held[lane]
         )
@@ -149,11 +153,7 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
             scatter(rate, out, lane)
         elif failed and out.shape[0] > STATE:  # the failure state's rates
             y, rate = gather(src, lane, lanes.one_state), lanes.one_rate
-            side = -1.0 if y[THETA_] < 0.0 else 1.0
-            contact = contact_of(
-                model, scene_of(scenes, i), y, side * y[THETA_], side * out[THETA_, lane]
-            )
-            model.state_rates(contact, rate[STATE:])
+            failure_state_rates(model, scene_of(scenes, i), y, out[THETA_, lane], rate[STATE:])
             for row in range(STATE, out.shape[0]):
                 out[row, lane] = rate[row]
 
@@ -205,6 +205,7 @@ def lane_event_margins(
 
 #: The functions of numbers a compiled path compiles (callees before callers).
 KERNELS = (
+    surface_of_lane,
     lane_surfaces,
     lane_forces,
     lane_failure_forces,

@@ -82,6 +82,17 @@ def failure_force(
     return -relieved_drag + extra_drag, -relieved_lift + extra_lift
 
 
+def failure_state_rates(
+    model: CompiledModel, scene: SceneConstants, y: Any, obliquity_rate: float, out: Any
+) -> None:
+    """The failure state's rates [unit/s] into ``out`` at ``y``, where θ changes at
+    ``obliquity_rate`` [rad/s]: the failure model sees the mirror image for θ < 0, |θ|
+    and d|θ|/dt."""
+    side = -1.0 if y[THETA_] < 0.0 else 1.0
+    contact = contact_of(model, scene, y, side * y[THETA_], side * obliquity_rate)
+    model.state_rates(contact, out)
+
+
 def motion(
     surface: Any, drag: float, lift: float, side: float, speed: float, mass: float, held: bool
 ) -> tuple[float, float, float, float]:
@@ -110,8 +121,7 @@ def rates(
         surface, drag, lift, side, speed, scene.mass, held
     )
     if failed:
-        contact = contact_of(model, scene, y, side * theta, side * out[THETA_])
-        model.state_rates(contact, out[STATE:])
+        failure_state_rates(model, scene, y, out[THETA_], out[STATE:])
     else:
         for row in range(STATE, y.size):
             out[row] = 0.0
@@ -164,6 +174,7 @@ def branch_margins(
 KERNELS = (
     contact_of,
     failure_force,
+    failure_state_rates,
     motion,
     rates,
     kinematic_margins,
