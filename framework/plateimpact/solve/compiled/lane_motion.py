@@ -4,8 +4,9 @@ every lane at once, stored lane-major (``src[row, lane]``), calling the same for
 Each loop over the lanes calls only inlined, branch-free code (the geometry's eq-6 branch
 and :mod:`plateimpact.elementary`'s functions), so LLVM vectorises it: a pass over the
 16 lanes costs a few scenes' worth. The relieved force of a failed plate (eqs 9–15) is a
-second such pass. What only some lanes need is then done lane by lane by the scalar
-kernels: the law's stress (its constants are the scene's row), what a failure model adds
+second such pass. The law's stress is an inline copy of its kernel on each lane's
+constants (lane-major), in the same loop. What only some lanes need is then done lane
+by lane by the scalar kernels: what a failure model adds
 on top of its relief, the failure state's rates, and the turn-around ring of eq 6, which
 the scalar rates redo whole. A lane's numbers are therefore the scalar path's, bit for
 bit (tested).
@@ -71,21 +72,17 @@ def lane_surfaces(lanes: Lanes, src: Any, depth: Any, surface: Any, ring: Any) -
 
 
 def lane_forces(
-    model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, surface: Any,
-    only_failed: bool, drag: Any, lift: Any,
-) -> None:  # fmt: skip
+    model: CompiledModel, lanes: Lanes, src: Any, surface: Any, drag: Any, lift: Any
+) -> None:
     """The law's drag and lift [N] on each lane's ``surface`` (:func:`force_on_surface`):
-    the stress one lane at a time (its constants are the scene's row), the force as a
-    vector. ``only_failed``: the stress only where the plate has failed."""
-    stress = lanes.stress
+    its stress, an inline copy of the law's kernel, on each lane's constants
+    (``lanes.law``, lane-major), and the force, all in one vector loop."""
+    law = lanes.law
     for lane in range(WIDTH):
-        i = lanes.scene[lane]
-        if i >= 0 and (lanes.failed[lane] or not only_failed):
-            incidence = np.abs(src[THETA_, lane]) - surface[1, lane]
-            stress[lane] = model.stress(src[V_, lane], incidence, scenes.law_constants[i])
-    for lane in range(WIDTH):
+        incidence = np.abs(src[THETA_, lane]) - surface[1, lane]
+        stress = model.stress_in_lanes(src[V_, lane], incidence, law[:, lane])
         here = surface_of_lane(surface, lane)
-        drag[lane], lift[lane] = force_from_stress(here, stress[lane])
+        drag[lane], lift[lane] = force_from_stress(here, stress)
 
 
 def lane_failure_forces(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any) -> None:
@@ -96,7 +93,7 @@ def lane_failure_forces(model: CompiledModel, lanes: Lanes, scenes: Batch, src: 
     relief = model.relief_column >= 0
     if relief:
         lane_surfaces(lanes, src, lanes.depth, lanes.relieved, lanes.relieved_ring)
-        lane_forces(model, lanes, scenes, src, lanes.relieved, True, extra_drag, extra_lift)
+        lane_forces(model, lanes, src, lanes.relieved, extra_drag, extra_lift)
         for lane in range(WIDTH):
             extra_drag[lane], extra_lift[lane] = -extra_drag[lane], -extra_lift[lane]  # eq 15
     if model.force_besides_relief or not relief:
@@ -123,7 +120,7 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
     """dy/dt at every lane's row of ``src`` into ``out`` (:func:`~.motion.rates`)."""
     surface, drag, lift = lanes.surface, lanes.drag, lanes.lift
     lane_surfaces(lanes, src, lanes.no_depth, surface, lanes.ring)
-    lane_forces(model, lanes, scenes, src, surface, False, drag, lift)
+    lane_forces(model, lanes, src, surface, drag, lift)
     any_failed = False
     for lane in range(WIDTH):
         any_failed = any_failed | (lanes.failed[lane] & (lanes.scene[lane] >= 0))

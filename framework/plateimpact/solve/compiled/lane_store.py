@@ -77,6 +77,7 @@ class Lanes(NamedTuple):
     surface: Any
     ring: Any
     stress: Any
+    law: Any
     drag: Any
     lift: Any
     depth: Any
@@ -113,8 +114,9 @@ class Lanes(NamedTuple):
 
 
 def lanes_scratch(
-    tab: Tableau, width: int, branch_rows: int, event_samples: int, events: int
-) -> Lanes:
+    tab: Tableau, width: int, branch_rows: int, event_samples: int, events: int,
+    law_width: int,
+) -> Lanes:  # fmt: skip
     """A chunk's lanes, allocated once (the kernels that use them allocate nothing, so
     they run without reference counting). Idle lanes hold harmless numbers."""
     s, q, n = tab.C.size, tab.P.shape[1], WIDTH
@@ -138,7 +140,7 @@ def lanes_scratch(
         np.zeros((s + 1, width, n)), np.zeros((q, width, n)), np.zeros((branch_rows, n)),
         np.zeros((branch_rows, n)), np.zeros((branch_rows, n), np.bool_),
         np.zeros((at.size, width, n)), np.zeros((at.size, events, n)), np.zeros((6, n)),
-        np.zeros(n, np.bool_), zeros.copy(),
+        np.zeros(n, np.bool_), zeros.copy(), np.zeros((law_width, n)),
         zeros.copy(), zeros.copy(), zeros.copy(), zeros.copy(), np.zeros((6, n)),
         np.zeros(n, np.bool_), zeros.copy(), zeros.copy(),
         zeros.copy(), ones.copy(), ones.copy(),

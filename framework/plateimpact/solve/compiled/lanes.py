@@ -60,6 +60,7 @@ def enter(
     column = model.relief_column
     lanes.depth[lane] = scenes.constants[i, column] if column >= 0 else 0.0
     scatter(scenes.y[i], lanes.y, lane)
+    scatter(scenes.law_constants[i], lanes.law, lane)
     scatter(scenes.scale[i], lanes.scale, lane)
     lanes.t[lane], lanes.max_penetration[lane] = 0.0, 0.0
     lanes.just_rejected[lane] = lanes.forced[lane] = lanes.margins_known[lane] = False

@@ -34,6 +34,7 @@ class CompiledModel(NamedTuple):
     state_rates: Any
     relief_column: int
     force_besides_relief: bool
+    stress_in_lanes: Any
 
 
 class SceneConstants(NamedTuple):
