@@ -24,7 +24,29 @@ import numpy as np
 from ...model.events import AT_REST, CONTACT_LOST, ONSET, PERFORATED, TURNED_BACK
 from ...model.geometry import _surface, branch_surfaces, eq6_inclination
 from ...model.resistance import force_from_stress
-from .lane_store import WIDTH, Batch, Lanes, gather, lane_twin, scatter, scene_of
+from .lane_store import (
+    DRAG,
+    EXTRA_DRAG,
+    EXTRA_LIFT,
+    FAILED,
+    HELD,
+    LIFT,
+    MASS,
+    NO_DEPTH,
+    ONSET_PENETRATION,
+    RADIUS,
+    RELIEF_DEPTH,
+    RELIEVED_RING,
+    REST_SPEED,
+    RING,
+    WIDTH,
+    Batch,
+    Lanes,
+    gather,
+    lane_twin,
+    scatter,
+    scene_of,
+)
 from .motion import (
     P_,
     STATE,
@@ -61,9 +83,10 @@ def lane_surfaces(lanes: Lanes, src: Any, depth: Any, surface: Any, ring: Any) -
     [m] above each lane's deepest point (P − depth for P: 0 for the intact surface, the
     failure plane's depth for the relieved one) at every lane's row of ``src``, into
     ``surface`` (6, lanes), φ from eq 6, and which lanes lie in the ring instead."""
+    value = lanes.value
     for lane in range(WIDTH):
         penetration = src[P_, lane] - depth[lane]
-        obliquity, radius = np.abs(src[THETA_, lane]), lanes.radius[lane]
+        obliquity, radius = np.abs(src[THETA_, lane]), value[RADIUS, lane]
         phi, in_ring = _eq6_inclination(penetration, obliquity, radius)[:2]
         area, phi, cos_psi, sin_psi, sin_t, cos_t = _surface_of(penetration, obliquity, radius, phi)
         surface[0, lane], surface[1, lane], surface[2, lane] = area, phi, cos_psi
@@ -87,19 +110,21 @@ def lane_forces(
 
 def lane_failure_forces(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any) -> None:
     """Each failed lane's change of drag and lift (:func:`~.motion.failure_force`) added
-    to ``lanes.drag`` and ``lanes.lift``: −F′ below the relief plane for every lane
+    to ``lanes.value[DRAG]`` and ``lanes.value[LIFT]``: −F′ below the relief plane for every lane
     together, what ``force_change`` adds lane by lane."""
-    extra_drag, extra_lift = lanes.extra_drag, lanes.extra_lift
+    value, flag = lanes.value, lanes.flag
+    extra_drag, extra_lift = value[EXTRA_DRAG], value[EXTRA_LIFT]
     relief = model.relief_column >= 0
     if relief:
-        lane_surfaces(lanes, src, lanes.depth, lanes.relieved, lanes.relieved_ring)
+        depth, ring = value[RELIEF_DEPTH], flag[RELIEVED_RING]
+        lane_surfaces(lanes, src, depth, lanes.relieved, ring)
         lane_forces(model, lanes, src, lanes.relieved, extra_drag, extra_lift)
         for lane in range(WIDTH):
             extra_drag[lane], extra_lift[lane] = -extra_drag[lane], -extra_lift[lane]  # eq 15
     if model.force_besides_relief or not relief:
         for lane in range(WIDTH):
             i = lanes.scene[lane]
-            if i >= 0 and lanes.failed[lane]:
+            if i >= 0 and flag[FAILED, lane]:
                 y = gather(src, lane, lanes.one_state)
                 contact = contact_of(model, scene_of(scenes, i), y, np.abs(y[THETA_]), np.nan)
                 more_drag, more_lift = model.force_change(contact)
@@ -109,21 +134,22 @@ def lane_failure_forces(model: CompiledModel, lanes: Lanes, scenes: Batch, src: 
                         extra_lift[lane] + more_lift,
                     )
                 extra_drag[lane], extra_lift[lane] = more_drag, more_lift
-    drag, lift = lanes.drag, lanes.lift
+    drag, lift = value[DRAG], value[LIFT]
     for lane in range(WIDTH):
-        failed = lanes.failed[lane]
+        failed = flag[FAILED, lane]
         drag[lane] = drag[lane] + extra_drag[lane] if failed else drag[lane]
         lift[lane] = lift[lane] + extra_lift[lane] if failed else lift[lane]
 
 
 def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any) -> None:
     """dy/dt at every lane's row of ``src`` into ``out`` (:func:`~.motion.rates`)."""
-    surface, drag, lift = lanes.surface, lanes.drag, lanes.lift
-    lane_surfaces(lanes, src, lanes.no_depth, surface, lanes.ring)
+    value, flag = lanes.value, lanes.flag
+    surface, drag, lift = lanes.surface, value[DRAG], value[LIFT]
+    lane_surfaces(lanes, src, value[NO_DEPTH], surface, flag[RING])
     lane_forces(model, lanes, src, surface, drag, lift)
     any_failed = False
     for lane in range(WIDTH):
-        any_failed = any_failed | (lanes.failed[lane] & (lanes.scene[lane] >= 0))
+        any_failed = any_failed | (flag[FAILED, lane] & (lanes.scene[lane] >= 0))
     if any_failed:
         lane_failure_forces(model, lanes, scenes, src)
     for lane in range(WIDTH):
@@ -131,7 +157,7 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
         side = -1.0 if theta < 0.0 else 1.0
         here = surface_of_lane(surface, lane)
         p_rate, y_rate, theta_rate, v_rate = motion(
-            here, drag[lane], lift[lane], side, speed, lanes.mass[lane], lanes.held[lane]
+            here, drag[lane], lift[lane], side, speed, value[MASS, lane], flag[HELD, lane]
         )
         out[P_, lane], out[Y_, lane] = p_rate, y_rate
         out[THETA_, lane], out[V_, lane] = theta_rate, v_rate
@@ -143,10 +169,10 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
         i = lanes.scene[lane]
         if i < 0:
             continue
-        failed = lanes.failed[lane]
-        if lanes.ring[lane] or (failed and relief and lanes.relieved_ring[lane]):
+        failed = flag[FAILED, lane]
+        if flag[RING, lane] or (failed and relief and flag[RELIEVED_RING, lane]):
             y, rate = gather(src, lane, lanes.one_state), lanes.one_rate
-            rates(model, scene_of(scenes, i), y, failed, lanes.held[lane], rate)
+            rates(model, scene_of(scenes, i), y, failed, flag[HELD, lane], rate)
             scatter(rate, out, lane)
         elif failed and out.shape[0] > STATE:  # the failure state's rates
             y, rate = gather(src, lane, lanes.one_state), lanes.one_rate
@@ -160,9 +186,10 @@ def lane_branch_margins(
 ) -> None:
     """The branch margins at every lane's row of ``src`` into ``out`` (rows, lanes)
     (:func:`~.motion.branch_margins`)."""
+    value, flag = lanes.value, lanes.flag
     for lane in range(WIDTH):
         first, second = branch_surfaces(
-            src[P_, lane], np.abs(src[THETA_, lane]), lanes.radius[lane]
+            src[P_, lane], np.abs(src[THETA_, lane]), value[RADIUS, lane]
         )
         out[0, lane], out[1, lane] = first, second
     for row in range(2, out.shape[0]):
@@ -171,7 +198,7 @@ def lane_branch_margins(
     if out.shape[0] > 2:
         for lane in range(WIDTH):
             i = lanes.scene[lane]
-            if i >= 0 and lanes.failed[lane]:
+            if i >= 0 and flag[FAILED, lane]:
                 y, margins = gather(src, lane, lanes.one_state), lanes.one_branch
                 branch_margins(model, scene_of(scenes, i), y, True, margins)
                 scatter(margins, out, lane)
@@ -182,11 +209,12 @@ def lane_event_margins(
 ) -> None:
     """The event margins at every lane's row of ``src`` into ``out`` (events, lanes)
     (:func:`~.motion.event_margins`)."""
+    value, flag = lanes.value, lanes.flag
     for lane in range(WIDTH):
         onset, lost, rest, back = kinematic_margins(
-            src[P_, lane], np.abs(src[THETA_, lane]), src[V_, lane], lanes.radius[lane],
-            lanes.rest_speed[lane], lanes.onset_penetration[lane], scenes.turn_back_limit,
-            scenes.adds_onset, lanes.failed[lane], lanes.held[lane],
+            src[P_, lane], np.abs(src[THETA_, lane]), src[V_, lane], value[RADIUS, lane],
+            value[REST_SPEED, lane], value[ONSET_PENETRATION, lane], scenes.turn_back_limit,
+            scenes.adds_onset, flag[FAILED, lane], flag[HELD, lane],
         )  # fmt: skip
         out[ONSET, lane], out[CONTACT_LOST, lane] = onset, lost
         out[AT_REST, lane], out[TURNED_BACK, lane] = rest, back
@@ -194,9 +222,9 @@ def lane_event_margins(
     if scenes.adds_perforation:
         for lane in range(WIDTH):
             i = lanes.scene[lane]
-            if i >= 0 and lanes.failed[lane]:
+            if i >= 0 and flag[FAILED, lane]:
                 y, margins = gather(src, lane, lanes.one_state), lanes.one_event
-                event_margins(model, scene_of(scenes, i), y, True, lanes.held[lane], margins)
+                event_margins(model, scene_of(scenes, i), y, True, flag[HELD, lane], margins)
                 scatter(margins, out, lane)
 
 

@@ -16,7 +16,31 @@ import numpy as np
 from ...model.geometry import HALF_PI
 from ..control import BRANCH_CROSSING
 from .lane_motion import lane_branch_margins, lane_event_margins, lane_rates
-from .lane_store import WIDTH, Batch, Lanes, gather, scatter, scene_of
+from .lane_store import (
+    ACCEPTED,
+    CROSSED,
+    EVENTFUL,
+    FAILED,
+    FINITE,
+    FORCED,
+    JUST_REJECTED,
+    LANDING,
+    MARGINS_KNOWN,
+    MAX_PENETRATION,
+    NEXT_STEP,
+    NORM,
+    PLANNED_STEP,
+    STEP,
+    TOTAL,
+    UNIT,
+    WHERE,
+    WIDTH,
+    Batch,
+    Lanes,
+    gather,
+    scatter,
+    scene_of,
+)
 from .motion import P_, THETA_, CompiledModel, branch_margins
 from .stepping import Tableau, approach, crossing_fraction, error_ratio, next_step, redo_onto
 
@@ -24,7 +48,8 @@ from .stepping import Tableau, approach, crossing_fraction, error_ratio, next_st
 def lane_combine(lanes: Lanes, weights: Any, h_scaled: bool, out: Any) -> None:
     """out = y + h Σ_j weights[j] k_j per lane (or the sum alone when not
     ``h_scaled``), in stage order with zero weights skipped (:func:`~.stepping.combine`)."""
-    stages, total, y, h = lanes.stages, lanes.total, lanes.y, lanes.h
+    value = lanes.value
+    stages, total, y, h = lanes.stages, value[TOTAL], lanes.y, value[STEP]
     for k in range(out.shape[0]):
         for lane in range(WIDTH):
             total[lane] = 0.0
@@ -44,37 +69,40 @@ def lane_combine(lanes: Lanes, weights: Any, h_scaled: bool, out: Any) -> None:
 def lane_propose(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) -> None:
     """Every lane's step to try into ``h``, its planned step and whether it lands on a
     branch surface (:func:`~.stepping.propose`)."""
+    value, flag = lanes.value, lanes.flag
     for lane in range(WIDTH):
-        h = np.minimum(lanes.h_next[lane], tab.max_step * lanes.unit[lane])
-        lanes.h[lane], lanes.planned[lane], lanes.landing[lane] = h, h, False
+        h = np.minimum(value[NEXT_STEP, lane], tab.max_step * value[UNIT, lane])
+        value[STEP, lane], value[PLANNED_STEP, lane], flag[LANDING, lane] = h, h, False
     if not tab.branch_landing:
         return
     for lane in range(WIDTH):  # after an event: the margins at y, lane by lane (rare)
         i = lanes.scene[lane]
-        if i >= 0 and not lanes.margins_known[lane]:
+        if i >= 0 and not flag[MARGINS_KNOWN, lane]:
             y, margins = gather(lanes.y, lane, lanes.one_state), lanes.one_branch
-            branch_margins(model, scene_of(scenes, i), y, lanes.failed[lane], margins)
+            branch_margins(model, scene_of(scenes, i), y, flag[FAILED, lane], margins)
             scatter(margins, lanes.margins, lane)
-    y, derivative, trial, h = lanes.y, lanes.stages[0], lanes.trial, lanes.h
+    y, derivative, trial, h = lanes.y, lanes.stages[0], lanes.trial, value[STEP]
     for k in range(y.shape[0]):
         for lane in range(WIDTH):
             trial[k, lane] = y[k, lane] + h[lane] * derivative[k, lane]
     lane_branch_margins(model, lanes, scenes, trial, lanes.ahead)
-    fraction = lanes.where
+    fraction = value[WHERE]
     for lane in range(WIDTH):
         fraction[lane] = np.inf
     for r in range(lanes.margins.shape[0]):
         for lane in range(WIDTH):
             row_fraction = crossing_fraction(lanes.margins[r, lane], lanes.ahead[r, lane])
-            lanes.crossing[r, lane] = (row_fraction < BRANCH_CROSSING) | lanes.forced[lane]
+            lanes.crossing[r, lane] = (row_fraction < BRANCH_CROSSING) | flag[FORCED, lane]
             fraction[lane] = np.minimum(fraction[lane], row_fraction)
     for lane in range(WIDTH):
-        lanes.h[lane], lanes.landing[lane] = approach(h[lane], fraction[lane], lanes.forced[lane])
+        h_lane, landing = approach(h[lane], fraction[lane], flag[FORCED, lane])
+        value[STEP, lane], flag[LANDING, lane] = h_lane, landing
 
 
 def lane_advance(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) -> None:
     """Every lane's step of its ``h``: the stages, the new state, its error and the FSAL
     stage (:func:`~.stepping.advance`)."""
+    value = lanes.value
     s = tab.C.size
     for i in range(1, s):
         lane_combine(lanes, tab.A[i], True, lanes.trial)  # A is zero from column i on
@@ -82,7 +110,7 @@ def lane_advance(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch
     lane_combine(lanes, tab.B, True, lanes.y_new)
     lane_rates(model, lanes, scenes, lanes.y_new, lanes.stages[s])
     lane_combine(lanes, tab.E, False, lanes.error)
-    error, h = lanes.error, lanes.h
+    error, h = lanes.error, value[STEP]
     for k in range(error.shape[0]):
         for lane in range(WIDTH):
             error[k, lane] = h[lane] * error[k, lane]
@@ -92,7 +120,8 @@ def lane_judge(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) 
     """Whether each lane's step is accepted, its next step, whether it counts as
     rejected and whether the next must cross a surface just ahead
     (:func:`~.stepping.judge`)."""
-    y, y_new, norm, finite = lanes.y, lanes.y_new, lanes.norm, lanes.finite
+    value, flag = lanes.value, lanes.flag
+    y, y_new, norm, finite = lanes.y, lanes.y_new, value[NORM], flag[FINITE]
     for lane in range(WIDTH):
         norm[lane], finite[lane] = 0.0, True
     for k in range(y.shape[0]):
@@ -104,17 +133,17 @@ def lane_judge(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) 
             norm[lane] = ratio if k == 0 else np.maximum(norm[lane], ratio)
     for lane in range(WIDTH):  # a power each: lane by lane
         ok, h_next = next_step(
-            tab, norm[lane], finite[lane], lanes.h[lane], lanes.planned[lane],
-            lanes.landing[lane], lanes.just_rejected[lane],
+            tab, norm[lane], finite[lane], value[STEP, lane], value[PLANNED_STEP, lane],
+            flag[LANDING, lane], flag[JUST_REJECTED, lane],
         )  # fmt: skip
-        lanes.accepted[lane], lanes.h_next[lane] = ok, h_next
-        lanes.just_rejected[lane], lanes.forced[lane] = not ok, False
+        flag[ACCEPTED, lane], value[NEXT_STEP, lane] = ok, h_next
+        flag[JUST_REJECTED, lane], flag[FORCED, lane] = not ok, False
     if not tab.branch_landing:
         return
     # A step that ended across a surface it did not plan to cross is refused and redone
     # onto it (the margins at its start are in lanes.margins since propose).
     lane_branch_margins(model, lanes, scenes, y_new, lanes.ahead)
-    where, crossed = lanes.where, lanes.crossed
+    where, crossed = value[WHERE], flag[CROSSED]
     for lane in range(WIDTH):
         where[lane], crossed[lane] = np.inf, False
     for r in range(lanes.margins.shape[0]):
@@ -125,10 +154,10 @@ def lane_judge(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) 
             fraction = start / (start - end) if unplanned else np.inf
             where[lane] = np.minimum(where[lane], fraction)
     for lane in range(WIDTH):
-        if lanes.accepted[lane] and crossed[lane]:
-            h_again, forced = redo_onto(lanes.h[lane], where[lane])
-            lanes.accepted[lane], lanes.h_next[lane] = False, h_again
-            lanes.just_rejected[lane], lanes.forced[lane] = True, forced
+        if flag[ACCEPTED, lane] and crossed[lane]:
+            h_again, forced = redo_onto(value[STEP, lane], where[lane])
+            flag[ACCEPTED, lane], value[NEXT_STEP, lane] = False, h_again
+            flag[JUST_REJECTED, lane], flag[FORCED, lane] = True, forced
 
 
 def lane_sample(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) -> None:
@@ -136,7 +165,8 @@ def lane_sample(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch)
     anything happens in the step: a margin reaching zero, or θ rising through 90°
     (:func:`~.stepping.dense_coefficients`, :func:`~.stepping.dense_state`, the samples
     of :func:`~.scene.integrate_scene`)."""
-    coefficients, stages, h, y = lanes.coefficients, lanes.stages, lanes.h, lanes.y
+    value, flag = lanes.value, lanes.flag
+    coefficients, stages, h, y = lanes.coefficients, lanes.stages, value[STEP], lanes.y
     q_count, d = coefficients.shape[0], coefficients.shape[1]
     for q in range(q_count):
         for k in range(d):
@@ -153,13 +183,13 @@ def lane_sample(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch)
         for k in range(d):
             for lane in range(WIDTH):
                 coefficients[q, k, lane] *= h[lane]
-    at, samples, last = lanes.ev.at, lanes.samples, q_count - 1
+    at, samples, last = lanes.at, lanes.samples, q_count - 1
     count = at.size
     for k in range(d):
         for lane in range(WIDTH):
             samples[0, k, lane] = y[k, lane]
             samples[count - 1, k, lane] = lanes.y_new[k, lane]
-    total = lanes.total
+    total = value[TOTAL]
     for j in range(1, count - 1):
         sigma = at[j]
         for k in range(d):  # Horner, as dense_state, the lanes innermost
@@ -172,7 +202,7 @@ def lane_sample(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch)
                 samples[j, k, lane] = y[k, lane] + total[lane]
     for j in range(count):
         lane_event_margins(model, lanes, scenes, samples[j], lanes.event_margins[j])
-    eventful, margins = lanes.eventful, lanes.event_margins
+    eventful, margins = flag[EVENTFUL], lanes.event_margins
     for lane in range(WIDTH):
         eventful[lane] = False
     # (& and | rather than `and` and `or`: no branch in a vector loop)
@@ -191,20 +221,21 @@ def lane_move_on(tab: Tableau, lanes: Lanes) -> None:
     """Every accepted lane in which nothing happens moves to its step's end: maximum
     penetration, state, carried derivative and margins (the usual step of
     :func:`~.scene.settle`; the driver moves its time)."""
-    s, count = tab.C.size, lanes.ev.at.size
-    peak, moving = lanes.norm, lanes.total  # moving: 1.0 where the lane moves on
+    value, flag = lanes.value, lanes.flag
+    s, count = tab.C.size, lanes.at.size
+    peak, moving = value[NORM], value[TOTAL]  # moving: 1.0 where the lane moves on
     for lane in range(WIDTH):
         peak[lane] = -np.inf
     for j in range(count):
         for lane in range(WIDTH):
             peak[lane] = np.maximum(peak[lane], lanes.samples[j, P_, lane])
     for lane in range(WIDTH):
-        go = lanes.accepted[lane] and not lanes.eventful[lane]
+        go = flag[ACCEPTED, lane] and not flag[EVENTFUL, lane]
         moving[lane] = 1.0 if go else 0.0
         peak[lane] = np.maximum(peak[lane], lanes.y_new[P_, lane])
         if go:
-            lanes.max_penetration[lane] = np.maximum(lanes.max_penetration[lane], peak[lane])
-            lanes.margins_known[lane] = True
+            value[MAX_PENETRATION, lane] = np.maximum(value[MAX_PENETRATION, lane], peak[lane])
+            flag[MARGINS_KNOWN, lane] = True
     for k in range(lanes.y.shape[0]):
         for lane in range(WIDTH):
             if moving[lane] == 1.0:

@@ -20,7 +20,24 @@ from .stepping import StepWork, Tableau
 WIDTH = 16
 #: Rows of ``Lanes.counts``: each lane's steps, accepted and rejected steps, force
 #: evaluations and next trajectory row.
-STEPS, ACCEPTED, REJECTED, EVALUATIONS, ROW = range(5)
+N_STEPS, N_ACCEPTED, N_REJECTED, N_EVALUATIONS, ROW = range(5)
+#: Rows of ``Lanes.value`` [SI]: each lane's scene constants (Rs, m, rest speed, onset
+#: penetration, time unit Rs/Vs, the relief plane's depth h and a row of zeros), the
+#: law's drag and lift and what failure adds, the step's time, size, next and planned
+#: size, the deepest penetration so far, and scratch (error norm, crossing, a sum).
+(
+    RADIUS, MASS, REST_SPEED, ONSET_PENETRATION, UNIT, RELIEF_DEPTH, NO_DEPTH, DRAG, LIFT,
+    EXTRA_DRAG, EXTRA_LIFT, TIME, STEP, NEXT_STEP, PLANNED_STEP, MAX_PENETRATION, NORM,
+    WHERE, TOTAL,
+) = range(19)  # fmt: skip
+#: Rows of ``Lanes.flag``: the point in eq 6's ring (intact, relieved surface); the step
+#: lands on a branch, follows a rejection, must cross, may skip the margins at its
+#: start; the plate failed; θ held at 180°; the step finite, accepted, across an
+#: unplanned surface, with an event.
+(
+    RING, RELIEVED_RING, LANDING, JUST_REJECTED, FORCED, MARGINS_KNOWN, FAILED, HELD,
+    FINITE, ACCEPTED, CROSSED, EVENTFUL,
+) = range(12)  # fmt: skip
 
 
 class Batch(NamedTuple):
@@ -51,17 +68,19 @@ def scene_of(scenes: Batch, i: int) -> SceneConstants:
 
 
 class Lanes(NamedTuple):
-    """A chunk's lanes: the scene in each (−1: none) and its constants, state and step,
-    stages, dense output, samples and margins (``[..., lane]``), per-lane flags and
-    counts, one scene's arrays for the scalar kernels, and :mod:`.scene`'s scratch for
-    the steps in which an event happens."""
+    """A chunk's lanes: the scene in each (−1: none), the per-lane numbers and flags
+    (``value[VALUE_ROW, lane]``, ``flag[FLAG_ROW, lane]``), state and step, stages,
+    dense output, samples and margins (``[..., lane]``), counts, and one scene's arrays
+    for the scalar kernels.
+
+    Few arrays, not one per number: numba passes every array of a tuple to every
+    function as separate arguments, and the compile time grows with their count."""
 
     scene: Any
-    radius: Any
-    mass: Any
-    rest_speed: Any
-    onset_penetration: Any
-    unit: Any
+    value: Any
+    flag: Any
+    counts: Any
+    law: Any
     scale: Any
     y: Any
     trial: Any
@@ -72,53 +91,24 @@ class Lanes(NamedTuple):
     margins: Any
     ahead: Any
     crossing: Any
+    at: Any
     samples: Any
     event_margins: Any
     surface: Any
-    ring: Any
-    stress: Any
-    law: Any
-    drag: Any
-    lift: Any
-    depth: Any
-    no_depth: Any
     relieved: Any
-    relieved_ring: Any
-    extra_drag: Any
-    extra_lift: Any
-    t: Any
-    h: Any
-    h_next: Any
-    planned: Any
-    max_penetration: Any
-    norm: Any
-    where: Any
-    total: Any
-    landing: Any
-    just_rejected: Any
-    forced: Any
-    margins_known: Any
-    failed: Any
-    held: Any
-    finite: Any
-    accepted: Any
-    crossed: Any
-    eventful: Any
-    counts: Any
     one_state: Any
     one_rate: Any
     one_branch: Any
     one_event: Any
-    work: StepWork
-    ev: EventWork
 
 
 def lanes_scratch(
     tab: Tableau, width: int, branch_rows: int, event_samples: int, events: int,
     law_width: int,
-) -> Lanes:  # fmt: skip
-    """A chunk's lanes, allocated once (the kernels that use them allocate nothing, so
-    they run without reference counting). Idle lanes hold harmless numbers."""
+) -> tuple[Lanes, StepWork, EventWork]:  # fmt: skip
+    """A chunk's lanes and :mod:`.scene`'s scratch for the steps in which an event
+    happens, allocated once (the kernels that use them allocate nothing, so they run
+    without reference counting). Idle lanes hold harmless numbers."""
     s, q, n = tab.C.size, tab.P.shape[1], WIDTH
     y = np.zeros((width, n))
     y[3] = 1.0  # V
@@ -132,23 +122,19 @@ def lanes_scratch(
         at, np.zeros((at.size, width)), np.zeros((at.size, events)), np.zeros(events),
         np.zeros(width), np.zeros(events),
     )  # fmt: skip
-    ones, zeros = np.ones(n), np.zeros(n)
-    flags = [np.zeros(n, np.bool_) for _ in range(10)]
-    return Lanes(
-        np.full(n, -1, np.int64), ones.copy(), ones.copy(), zeros.copy(), zeros.copy(),
-        ones.copy(), np.ones((width, n)), y, y.copy(), y.copy(), np.zeros((width, n)),
-        np.zeros((s + 1, width, n)), np.zeros((q, width, n)), np.zeros((branch_rows, n)),
-        np.zeros((branch_rows, n)), np.zeros((branch_rows, n), np.bool_),
-        np.zeros((at.size, width, n)), np.zeros((at.size, events, n)), np.zeros((6, n)),
-        np.zeros(n, np.bool_), zeros.copy(), np.zeros((law_width, n)),
-        zeros.copy(), zeros.copy(), zeros.copy(), zeros.copy(), np.zeros((6, n)),
-        np.zeros(n, np.bool_), zeros.copy(), zeros.copy(),
-        zeros.copy(), ones.copy(), ones.copy(),
-        ones.copy(), zeros.copy(), zeros.copy(), zeros.copy(), zeros.copy(),
-        flags[0], flags[1], flags[2], flags[3], flags[4], flags[5], flags[6], flags[7],
-        flags[8], flags[9], np.zeros((5, n), np.int64), np.zeros(width), np.zeros(width),
-        np.zeros(branch_rows), np.zeros(events), work, ev,
+    value = np.zeros((TOTAL + 1, n))
+    for row in (RADIUS, MASS, UNIT, STEP, NEXT_STEP, PLANNED_STEP):
+        value[row] = 1.0
+    lanes = Lanes(
+        np.full(n, -1, np.int64), value, np.zeros((EVENTFUL + 1, n), np.bool_),
+        np.zeros((5, n), np.int64), np.zeros((law_width, n)), np.ones((width, n)), y,
+        y.copy(), y.copy(), np.zeros((width, n)), np.zeros((s + 1, width, n)),
+        np.zeros((q, width, n)), np.zeros((branch_rows, n)), np.zeros((branch_rows, n)),
+        np.zeros((branch_rows, n), np.bool_), at, np.zeros((at.size, width, n)),
+        np.zeros((at.size, events, n)), np.zeros((6, n)), np.zeros((6, n)),
+        np.zeros(width), np.zeros(width), np.zeros(branch_rows), np.zeros(events),
     )  # fmt: skip
+    return lanes, work, ev
 
 
 def lane_twin(function: Callable[..., Any]) -> Callable[..., Any]:

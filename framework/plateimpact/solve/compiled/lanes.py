@@ -15,13 +15,31 @@ from __future__ import annotations
 
 from typing import Any
 
+from .events import EventWork
 from .lane_steps import lane_advance, lane_judge, lane_move_on, lane_propose, lane_sample
 from .lane_store import (
     ACCEPTED,
-    EVALUATIONS,
-    REJECTED,
+    EVENTFUL,
+    FAILED,
+    FORCED,
+    HELD,
+    JUST_REJECTED,
+    MARGINS_KNOWN,
+    MASS,
+    MAX_PENETRATION,
+    N_ACCEPTED,
+    N_EVALUATIONS,
+    N_REJECTED,
+    N_STEPS,
+    NEXT_STEP,
+    ONSET_PENETRATION,
+    RADIUS,
+    RELIEF_DEPTH,
+    REST_SPEED,
     ROW,
-    STEPS,
+    STEP,
+    TIME,
+    UNIT,
     WIDTH,
     Batch,
     Lanes,
@@ -43,7 +61,7 @@ from .scene import (
 )
 from .scene import REJECTED as COUNT_REJECTED
 from .scene import STEPS as COUNT_STEPS
-from .stepping import Tableau
+from .stepping import StepWork, Tableau
 
 
 def enter(
@@ -52,25 +70,26 @@ def enter(
 ) -> None:  # fmt: skip
     """Scene ``i`` into ``lane`` at first contact: its constants, state and carried
     derivative, its first trajectory row."""
+    value, flag = lanes.value, lanes.flag
     core = scenes.core
     lanes.scene[lane] = i
-    lanes.radius[lane], lanes.mass[lane] = core[i, 0], core[i, 1]
-    lanes.rest_speed[lane], lanes.onset_penetration[lane] = core[i, 2], core[i, 3]
-    lanes.h_next[lane], lanes.unit[lane] = core[i, 4], core[i, 5]
+    value[RADIUS, lane], value[MASS, lane] = core[i, 0], core[i, 1]
+    value[REST_SPEED, lane], value[ONSET_PENETRATION, lane] = core[i, 2], core[i, 3]
+    value[NEXT_STEP, lane], value[UNIT, lane] = core[i, 4], core[i, 5]
     column = model.relief_column
-    lanes.depth[lane] = scenes.constants[i, column] if column >= 0 else 0.0
+    value[RELIEF_DEPTH, lane] = scenes.constants[i, column] if column >= 0 else 0.0
     scatter(scenes.y[i], lanes.y, lane)
     scatter(scenes.law_constants[i], lanes.law, lane)
     scatter(scenes.scale[i], lanes.scale, lane)
-    lanes.t[lane], lanes.max_penetration[lane] = 0.0, 0.0
-    lanes.just_rejected[lane] = lanes.forced[lane] = lanes.margins_known[lane] = False
-    lanes.failed[lane] = lanes.held[lane] = False
+    value[TIME, lane], value[MAX_PENETRATION, lane] = 0.0, 0.0
+    for row in (JUST_REJECTED, FORCED, MARGINS_KNOWN, FAILED, HELD):
+        flag[row, lane] = False
     rate = lanes.one_rate
     rates(model, scene_of(scenes, i), scenes.y[i], False, False, rate)  # first same as last
     scatter(rate, lanes.stages[0], lane)
     counts = lanes.counts
-    counts[STEPS, lane] = counts[ACCEPTED, lane] = counts[REJECTED, lane] = 0
-    counts[EVALUATIONS, lane] = 1
+    counts[N_STEPS, lane] = counts[N_ACCEPTED, lane] = counts[N_REJECTED, lane] = 0
+    counts[N_EVALUATIONS, lane] = 1
     counts[ROW, lane] = record(trajectory, first_row, writing, 0.0, scenes.y[i], False)
 
 
@@ -79,29 +98,32 @@ def leave(
 ) -> None:
     """The lane's scene's final state and counts into its rows of the results
     (:func:`~.scene.integrate_scene`'s last lines); the lane left idle."""
+    value, flag = lanes.value, lanes.flag
     i = lanes.scene[lane]
     y = gather(lanes.y, lane, scenes.y[i])
     mine, tally = results[i], counts[i]
-    tally[PLATE_FAILED] = 1 if lanes.failed[lane] else 0
-    tally[COUNT_STEPS] = lanes.counts[STEPS, lane]
-    tally[COUNT_ACCEPTED] = lanes.counts[ACCEPTED, lane]
-    tally[COUNT_REJECTED] = lanes.counts[REJECTED, lane]
-    tally[COUNT_EVALUATIONS] = lanes.counts[EVALUATIONS, lane]
+    tally[PLATE_FAILED] = 1 if flag[FAILED, lane] else 0
+    tally[COUNT_STEPS] = lanes.counts[N_STEPS, lane]
+    tally[COUNT_ACCEPTED] = lanes.counts[N_ACCEPTED, lane]
+    tally[COUNT_REJECTED] = lanes.counts[N_REJECTED, lane]
+    tally[COUNT_EVALUATIONS] = lanes.counts[N_EVALUATIONS, lane]
     tally[SAMPLES] = lanes.counts[ROW, lane] - first_row
-    mine[LAST_PENETRATION], mine[LAST_SPEED], mine[LAST_TIME] = y[P_], y[V_], lanes.t[lane]
+    mine[LAST_PENETRATION], mine[LAST_SPEED] = y[P_], y[V_]
+    mine[LAST_TIME] = value[TIME, lane]
     lanes.scene[lane] = -1
 
 
 def settle_lane(
-    model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch, lane: int,
+    model: CompiledModel, tab: Tableau, lanes: Lanes, work: StepWork, ev: EventWork,
+    scenes: Batch, lane: int,
     outcomes: Any, restarts: Any, embedment: int, results: Any, counts: Any, writing: bool,
     trajectory: Any,
 ) -> bool:  # fmt: skip
     """A lane's accepted step in which something happens, by the scalar path's
     :func:`~.scene.settle`: the lane's arrays copied into one scene's scratch and back.
     Whether the scene ended."""
+    value, flag = lanes.value, lanes.flag
     i = lanes.scene[lane]
-    work, ev = lanes.work, lanes.ev
     for j in range(work.stages.shape[0]):
         gather(lanes.stages[j], lane, work.stages[j])
     for q in range(work.coefficients.shape[0]):
@@ -114,15 +136,15 @@ def settle_lane(
     gather(lanes.margins, lane, work.margins)
     y = gather(lanes.y, lane, lanes.one_state)
     t, failed, held, peak, row, hit, restarted, ended = settle(
-        model, scene_of(scenes, i), tab, work, ev, y, lanes.h[lane], lanes.t[lane],
-        lanes.failed[lane], lanes.held[lane], lanes.max_penetration[lane],
+        model, scene_of(scenes, i), tab, work, ev, y, value[STEP, lane], value[TIME, lane],
+        flag[FAILED, lane], flag[HELD, lane], value[MAX_PENETRATION, lane],
         lanes.counts[ROW, lane], writing, trajectory, outcomes, restarts, embedment,
         results[i], counts[i],
     )  # fmt: skip
-    lanes.t[lane], lanes.failed[lane], lanes.held[lane] = t, failed, held
-    lanes.max_penetration[lane], lanes.counts[ROW, lane] = peak, row
-    lanes.counts[EVALUATIONS, lane] += 1 if restarted else 0
-    lanes.margins_known[lane] = not hit
+    value[TIME, lane], flag[FAILED, lane], flag[HELD, lane] = t, failed, held
+    value[MAX_PENETRATION, lane], lanes.counts[ROW, lane] = peak, row
+    lanes.counts[N_EVALUATIONS, lane] += 1 if restarted else 0
+    flag[MARGINS_KNOWN, lane] = not hit
     scatter(y, lanes.y, lane)
     scatter(work.stages[0], lanes.stages[0], lane)
     scatter(work.margins, lanes.margins, lane)
@@ -132,8 +154,9 @@ def settle_lane(
 def write_rows(lanes: Lanes, lane: int, trajectory: Any) -> None:
     """The usual step's trajectory rows of a lane: its samples inside the step, then
     its end (:func:`~.scene.settle`, when writing)."""
-    at, t, h = lanes.ev.at, lanes.t[lane], lanes.h[lane]  # t: the step's start
-    y, row, failed = lanes.one_state, lanes.counts[ROW, lane], lanes.failed[lane]
+    value, flag = lanes.value, lanes.flag
+    at, t, h = lanes.at, value[TIME, lane], value[STEP, lane]  # t: the step's start
+    y, row, failed = lanes.one_state, lanes.counts[ROW, lane], flag[FAILED, lane]
     for j in range(1, at.size - 1):
         sample = gather(lanes.samples[j], lane, y)
         row = record(trajectory, row, True, t + at[j] * h, sample, failed)
@@ -141,12 +164,14 @@ def write_rows(lanes: Lanes, lane: int, trajectory: Any) -> None:
 
 
 def integrate_chunk(
-    model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch, start: int, stop: int,
+    model: CompiledModel, tab: Tableau, lanes: Lanes, work: StepWork, ev: EventWork,
+    scenes: Batch, start: int, stop: int,
     max_steps: int, outcomes: Any, restarts: Any, embedment: int, results: Any, counts: Any,
     writing: bool, trajectory: Any, first_rows: Any,
 ) -> None:  # fmt: skip
     """Scenes ``start`` .. ``stop`` − 1 into their rows of ``results`` and ``counts``
     (as :func:`~.scene.integrate_scene` writes them), lanes refilled as scenes end."""
+    value, flag = lanes.value, lanes.flag
     following = start
     for lane in range(WIDTH):
         lanes.scene[lane] = -1
@@ -154,7 +179,7 @@ def integrate_chunk(
             enter(model, lanes, scenes, lane, following, writing, trajectory,
                   first_rows[following])  # fmt: skip
             following += 1
-    rows = lanes.ev.at.size - 1  # a usual step's trajectory rows
+    rows = lanes.at.size - 1  # a usual step's trajectory rows
     while True:
         busy = False
         for lane in range(WIDTH):
@@ -163,7 +188,7 @@ def integrate_chunk(
             return
         lane_propose(model, tab, lanes, scenes)
         for lane in range(WIDTH):
-            lanes.margins_known[lane] = True
+            flag[MARGINS_KNOWN, lane] = True
         lane_advance(model, tab, lanes, scenes)
         lane_judge(model, tab, lanes, scenes)
         lane_sample(model, tab, lanes, scenes)
@@ -173,24 +198,24 @@ def integrate_chunk(
             if i < 0:
                 continue
             tally = lanes.counts
-            tally[STEPS, lane] += 1
-            tally[EVALUATIONS, lane] += tab.C.size
+            tally[N_STEPS, lane] += 1
+            tally[N_EVALUATIONS, lane] += tab.C.size
             ended = False
-            if not lanes.accepted[lane]:
-                tally[REJECTED, lane] += 1
+            if not flag[ACCEPTED, lane]:
+                tally[N_REJECTED, lane] += 1
             else:
-                tally[ACCEPTED, lane] += 1
-                if lanes.eventful[lane]:
+                tally[N_ACCEPTED, lane] += 1
+                if flag[EVENTFUL, lane]:
                     ended = settle_lane(
-                        model, tab, lanes, scenes, lane, outcomes, restarts, embedment,
+                        model, tab, lanes, work, ev, scenes, lane, outcomes, restarts, embedment,
                         results, counts, writing, trajectory,
                     )  # fmt: skip
                 else:  # the usual step: moved on by lane_move_on, but for its time
                     if writing:
                         write_rows(lanes, lane, trajectory)
                     tally[ROW, lane] += rows
-                    lanes.t[lane] = lanes.t[lane] + 1.0 * lanes.h[lane]
-            if ended or tally[STEPS, lane] >= max_steps:
+                    value[TIME, lane] = value[TIME, lane] + 1.0 * value[STEP, lane]
+            if ended or tally[N_STEPS, lane] >= max_steps:
                 leave(lanes, scenes, lane, results, counts, first_rows[i])
                 if following < stop:
                     enter(model, lanes, scenes, lane, following, writing, trajectory,

@@ -76,11 +76,11 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
         core, y, scale, constants, law_constants, floats[3], floats[4], ints[1] != 0,
         ints[2] != 0,
     )
-    chunk = lane_store.lanes_scratch(
+    chunk, work, ev = lane_store.lanes_scratch(
         tab, y.shape[1], ints[4], ints[6], outcomes.size, law_constants.shape[1]
     )
     lanes.integrate_chunk(
-        model, tab, chunk, scenes, start, stop, ints[3], outcomes, restarts, ints[5],
+        model, tab, chunk, work, ev, scenes, start, stop, ints[3], outcomes, restarts, ints[5],
         results, counts, ints[7] != 0, trajectory, first_rows,
     )
 
