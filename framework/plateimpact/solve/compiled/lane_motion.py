@@ -78,29 +78,29 @@ def surface_of_lane(surface: Any, lane: int) -> tuple[float, ...]:
     )  # fmt: skip
 
 
-def lane_surfaces(lanes: Lanes, src: Any, depth: Any, surface: Any, ring: Any) -> None:
+def lane_surfaces(radius: Any, src: Any, depth: Any, surface: Any, ring: Any) -> None:
     """The contact surface (A, φ, cos ψ, sin ψ, sin θ, cos θ) below the plane ``depth``
     [m] above each lane's deepest point (P − depth for P: 0 for the intact surface, the
-    failure plane's depth for the relieved one) at every lane's row of ``src``, into
-    ``surface`` (6, lanes), φ from eq 6, and which lanes lie in the ring instead."""
-    value = lanes.value
+    failure plane's depth for the relieved one) at every lane's row of ``src``, with
+    sphere radii ``radius`` [m], into ``surface`` (6, lanes), φ from eq 6, and which
+    lanes lie in the ring instead. (Each lane function takes only the arrays it uses:
+    numba passes every array as separate arguments, which costs at each call.)"""
     for lane in range(WIDTH):
         penetration = src[P_, lane] - depth[lane]
-        obliquity, radius = np.abs(src[THETA_, lane]), value[RADIUS, lane]
-        phi, in_ring = _eq6_inclination(penetration, obliquity, radius)[:2]
-        area, phi, cos_psi, sin_psi, sin_t, cos_t = _surface_of(penetration, obliquity, radius, phi)
+        obliquity, sphere = np.abs(src[THETA_, lane]), radius[lane]
+        phi, in_ring = _eq6_inclination(penetration, obliquity, sphere)[:2]
+        area, phi, cos_psi, sin_psi, sin_t, cos_t = _surface_of(penetration, obliquity, sphere, phi)
         surface[0, lane], surface[1, lane], surface[2, lane] = area, phi, cos_psi
         surface[3, lane], surface[4, lane], surface[5, lane] = sin_psi, sin_t, cos_t
         ring[lane] = in_ring
 
 
 def lane_forces(
-    model: CompiledModel, lanes: Lanes, src: Any, surface: Any, drag: Any, lift: Any
+    model: CompiledModel, law: Any, src: Any, surface: Any, drag: Any, lift: Any
 ) -> None:
     """The law's drag and lift [N] on each lane's ``surface`` (:func:`force_on_surface`):
-    its stress, an inline copy of the law's kernel, on each lane's constants
-    (``lanes.law``, lane-major), and the force, all in one vector loop."""
-    law = lanes.law
+    its stress, an inline copy of the law's kernel, on each lane's constants ``law``
+    (lane-major), and the force, all in one vector loop."""
     for lane in range(WIDTH):
         incidence = np.abs(src[THETA_, lane]) - surface[1, lane]
         stress = model.stress_in_lanes(src[V_, lane], incidence, law[:, lane])
@@ -110,15 +110,15 @@ def lane_forces(
 
 def lane_failure_forces(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any) -> None:
     """Each failed lane's change of drag and lift (:func:`~.motion.failure_force`) added
-    to ``lanes.value[DRAG]`` and ``lanes.value[LIFT]``: −F′ below the relief plane for every lane
-    together, what ``force_change`` adds lane by lane."""
+    to its drag and lift (rows DRAG, LIFT of ``lanes.value``): −F′ below the relief
+    plane for every lane together, what ``force_change`` adds lane by lane."""
     value, flag = lanes.value, lanes.flag
     extra_drag, extra_lift = value[EXTRA_DRAG], value[EXTRA_LIFT]
     relief = model.relief_column >= 0
     if relief:
         depth, ring = value[RELIEF_DEPTH], flag[RELIEVED_RING]
-        lane_surfaces(lanes, src, depth, lanes.relieved, ring)
-        lane_forces(model, lanes, src, lanes.relieved, extra_drag, extra_lift)
+        lane_surfaces(value[RADIUS], src, depth, lanes.relieved, ring)
+        lane_forces(model, lanes.law, src, lanes.relieved, extra_drag, extra_lift)
         for lane in range(WIDTH):
             extra_drag[lane], extra_lift[lane] = -extra_drag[lane], -extra_lift[lane]  # eq 15
     if model.force_besides_relief or not relief:
@@ -145,8 +145,8 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
     """dy/dt at every lane's row of ``src`` into ``out`` (:func:`~.motion.rates`)."""
     value, flag = lanes.value, lanes.flag
     surface, drag, lift = lanes.surface, value[DRAG], value[LIFT]
-    lane_surfaces(lanes, src, value[NO_DEPTH], surface, flag[RING])
-    lane_forces(model, lanes, src, surface, drag, lift)
+    lane_surfaces(value[RADIUS], src, value[NO_DEPTH], surface, flag[RING])
+    lane_forces(model, lanes.law, src, surface, drag, lift)
     any_failed = False
     for lane in range(WIDTH):
         any_failed = any_failed | (flag[FAILED, lane] & (lanes.scene[lane] >= 0))

@@ -45,11 +45,12 @@ from .motion import P_, THETA_, CompiledModel, branch_margins
 from .stepping import Tableau, approach, crossing_fraction, error_ratio, next_step, redo_onto
 
 
-def lane_combine(lanes: Lanes, weights: Any, h_scaled: bool, out: Any) -> None:
+def lane_combine(
+    stages: Any, y: Any, h: Any, total: Any, weights: Any, h_scaled: bool, out: Any
+) -> None:
     """out = y + h Σ_j weights[j] k_j per lane (or the sum alone when not
-    ``h_scaled``), in stage order with zero weights skipped (:func:`~.stepping.combine`)."""
-    value = lanes.value
-    stages, total, y, h = lanes.stages, value[TOTAL], lanes.y, value[STEP]
+    ``h_scaled``), in stage order with zero weights skipped (:func:`~.stepping.combine`);
+    ``total``: a lane row of scratch."""
     for k in range(out.shape[0]):
         for lane in range(WIDTH):
             total[lane] = 0.0
@@ -102,15 +103,15 @@ def lane_propose(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch
 def lane_advance(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) -> None:
     """Every lane's step of its ``h``: the stages, the new state, its error and the FSAL
     stage (:func:`~.stepping.advance`)."""
-    value = lanes.value
+    stages, y, h, total = lanes.stages, lanes.y, lanes.value[STEP], lanes.value[TOTAL]
     s = tab.C.size
     for i in range(1, s):
-        lane_combine(lanes, tab.A[i], True, lanes.trial)  # A is zero from column i on
+        lane_combine(stages, y, h, total, tab.A[i], True, lanes.trial)  # A: 0 from column i
         lane_rates(model, lanes, scenes, lanes.trial, lanes.stages[i])
-    lane_combine(lanes, tab.B, True, lanes.y_new)
+    lane_combine(stages, y, h, total, tab.B, True, lanes.y_new)
     lane_rates(model, lanes, scenes, lanes.y_new, lanes.stages[s])
-    lane_combine(lanes, tab.E, False, lanes.error)
-    error, h = lanes.error, value[STEP]
+    lane_combine(stages, y, h, total, tab.E, False, lanes.error)
+    error = lanes.error
     for k in range(error.shape[0]):
         for lane in range(WIDTH):
             error[k, lane] = h[lane] * error[k, lane]
