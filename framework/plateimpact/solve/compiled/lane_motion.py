@@ -22,7 +22,8 @@ from typing import Any
 import numpy as np
 
 from ...model.events import AT_REST, CONTACT_LOST, ONSET, PERFORATED, TURNED_BACK
-from ...model.geometry import _surface, branch_surfaces, eq6_inclination
+from ...model.geometry import HALF_PI, _surface, branch_surfaces, eq6_inclination
+from ...model.kernels import KernelContact
 from ...model.resistance import force_from_stress
 from .lane_store import (
     DRAG,
@@ -54,9 +55,7 @@ from .motion import (
     V_,
     Y_,
     CompiledModel,
-    branch_margins,
     contact_of,
-    event_margins,
     failure_state_rates,
     kinematic_margins,
     motion,
@@ -181,34 +180,43 @@ def lane_rates(model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out:
                 out[row, lane] = rate[row]
 
 
-def lane_branch_margins(
-    model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any
-) -> None:
+def lane_contact(
+    model: CompiledModel, lanes: Lanes, src: Any, lane: int, obliquity: float
+) -> KernelContact:
+    """The failure model's view of a lane's row of ``src`` at |θ| = ``obliquity``
+    (:func:`~.motion.contact_of`), its constants read lane-major."""
+    return KernelContact(
+        src[P_, lane], obliquity, src[V_, lane], np.nan, src[STATE:, lane],
+        lanes.constants[:, lane], lanes.value[RADIUS, lane], model.stress,
+        lanes.law[:, lane],
+    )  # fmt: skip
+
+
+def lane_branch_margins(model: CompiledModel, lanes: Lanes, src: Any, out: Any) -> None:
     """The branch margins at every lane's row of ``src`` into ``out`` (rows, lanes)
-    (:func:`~.motion.branch_margins`)."""
+    (:func:`~.motion.branch_margins`): the failure model's rows by its kernel's inline
+    copy for every lane, NaN where the plate is intact."""
     value, flag = lanes.value, lanes.flag
     for lane in range(WIDTH):
         first, second = branch_surfaces(
             src[P_, lane], np.abs(src[THETA_, lane]), value[RADIUS, lane]
         )
         out[0, lane], out[1, lane] = first, second
-    for row in range(2, out.shape[0]):
-        for lane in range(WIDTH):
-            out[row, lane] = np.nan
     if out.shape[0] > 2:
         for lane in range(WIDTH):
-            i = lanes.scene[lane]
-            if i >= 0 and flag[FAILED, lane]:
-                y, margins = gather(src, lane, lanes.one_state), lanes.one_branch
-                branch_margins(model, scene_of(scenes, i), y, True, margins)
-                scatter(margins, out, lane)
+            contact = lane_contact(model, lanes, src, lane, np.abs(src[THETA_, lane]))
+            model.branch_margins_in_lanes(contact, out[2:, lane])
+        for row in range(2, out.shape[0]):
+            for lane in range(WIDTH):
+                out[row, lane] = out[row, lane] if flag[FAILED, lane] else np.nan
 
 
 def lane_event_margins(
     model: CompiledModel, lanes: Lanes, scenes: Batch, src: Any, out: Any
 ) -> None:
     """The event margins at every lane's row of ``src`` into ``out`` (events, lanes)
-    (:func:`~.motion.event_margins`)."""
+    (:func:`~.motion.event_margins`): perforation by the failure model's kernel's inline
+    copy for every lane, −inf where the plate is intact or θ >= 90°."""
     value, flag = lanes.value, lanes.flag
     for lane in range(WIDTH):
         onset, lost, rest, back = kinematic_margins(
@@ -221,11 +229,10 @@ def lane_event_margins(
         out[PERFORATED, lane] = -np.inf
     if scenes.adds_perforation:
         for lane in range(WIDTH):
-            i = lanes.scene[lane]
-            if i >= 0 and flag[FAILED, lane]:
-                y, margins = gather(src, lane, lanes.one_state), lanes.one_event
-                event_margins(model, scene_of(scenes, i), y, True, flag[HELD, lane], margins)
-                scatter(margins, out, lane)
+            obliquity = np.abs(src[THETA_, lane])
+            margin = model.perforation_in_lanes(lane_contact(model, lanes, src, lane, obliquity))
+            perforating = flag[FAILED, lane] & (obliquity < HALF_PI)
+            out[PERFORATED, lane] = margin if perforating else -np.inf
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).
@@ -239,4 +246,4 @@ KERNELS = (
     lane_event_margins,
 )
 #: Inlined where called.
-INLINE = (_eq6_inclination, _surface_of)
+INLINE = (_eq6_inclination, _surface_of, lane_contact)

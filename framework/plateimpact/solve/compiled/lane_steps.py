@@ -86,7 +86,7 @@ def lane_propose(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch
     for k in range(y.shape[0]):
         for lane in range(WIDTH):
             trial[k, lane] = y[k, lane] + h[lane] * derivative[k, lane]
-    lane_branch_margins(model, lanes, scenes, trial, lanes.ahead)
+    lane_branch_margins(model, lanes, trial, lanes.ahead)
     fraction = value[WHERE]
     for lane in range(WIDTH):
         fraction[lane] = np.inf
@@ -143,7 +143,7 @@ def lane_judge(model: CompiledModel, tab: Tableau, lanes: Lanes, scenes: Batch) 
         return
     # A step that ended across a surface it did not plan to cross is refused and redone
     # onto it (the margins at its start are in lanes.margins since propose).
-    lane_branch_margins(model, lanes, scenes, y_new, lanes.ahead)
+    lane_branch_margins(model, lanes, y_new, lanes.ahead)
     where, crossed = value[WHERE], flag[CROSSED]
     for lane in range(WIDTH):
         where[lane], crossed[lane] = np.inf, False

@@ -81,6 +81,7 @@ class Lanes(NamedTuple):
     flag: Any
     counts: Any
     law: Any
+    constants: Any
     scale: Any
     y: Any
     trial: Any
@@ -104,7 +105,7 @@ class Lanes(NamedTuple):
 
 def lanes_scratch(
     tab: Tableau, width: int, branch_rows: int, event_samples: int, events: int,
-    law_width: int,
+    law_width: int, failure_width: int,
 ) -> tuple[Lanes, StepWork, EventWork]:  # fmt: skip
     """A chunk's lanes and :mod:`.scene`'s scratch for the steps in which an event
     happens, allocated once (the kernels that use them allocate nothing, so they run
@@ -127,7 +128,8 @@ def lanes_scratch(
         value[row] = 1.0
     lanes = Lanes(
         np.full(n, -1, np.int64), value, np.zeros((EVENTFUL + 1, n), np.bool_),
-        np.zeros((5, n), np.int64), np.zeros((law_width, n)), np.ones((width, n)), y,
+        np.zeros((5, n), np.int64), np.zeros((law_width, n)),
+        np.zeros((failure_width, n)), np.ones((width, n)), y,
         y.copy(), y.copy(), np.zeros((width, n)), np.zeros((s + 1, width, n)),
         np.zeros((q, width, n)), np.zeros((branch_rows, n)), np.zeros((branch_rows, n)),
         np.zeros((branch_rows, n), np.bool_), at, np.zeros((at.size, width, n)),

@@ -80,6 +80,7 @@ def enter(
     value[RELIEF_DEPTH, lane] = scenes.constants[i, column] if column >= 0 else 0.0
     scatter(scenes.y[i], lanes.y, lane)
     scatter(scenes.law_constants[i], lanes.law, lane)
+    scatter(scenes.constants[i], lanes.constants, lane)
     scatter(scenes.scale[i], lanes.scale, lane)
     value[TIME, lane], value[MAX_PENETRATION, lane] = 0.0, 0.0
     for row in (JUST_REJECTED, FORCED, MARGINS_KNOWN, FAILED, HELD):

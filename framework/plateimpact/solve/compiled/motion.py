@@ -24,7 +24,9 @@ STATE = 4  # first failure-state row (KINEMATIC_STATE)
 
 class CompiledModel(NamedTuple):
     """The plug-ins' kernels: the law's stress, the failure model's :class:`FailureKernels`
-    (its ``relief_column``, and whether its ``force_change`` adds anything to a relief)."""
+    (its ``relief_column``, and whether its ``force_change`` adds anything to a relief),
+    and the inline copies of the stress and the margins that the lanes' vector loops
+    call (:func:`~.program.lane_kernel`)."""
 
     stress: Any
     force_change: Any
@@ -35,6 +37,8 @@ class CompiledModel(NamedTuple):
     relief_column: int
     force_besides_relief: bool
     stress_in_lanes: Any
+    perforation_in_lanes: Any
+    branch_margins_in_lanes: Any
 
 
 class SceneConstants(NamedTuple):

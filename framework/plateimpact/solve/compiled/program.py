@@ -64,20 +64,27 @@ from plateimpact.solve.compiled.stepping import Tableau
 
 {imports}
 
+# inline copies for the lanes' vector loops
 stress_in_lanes = program.lane_kernel(stress)
+perforation_in_lanes = program.lane_kernel(perforation_margin)
+branch_margins_in_lanes = program.lane_kernel(branch_margins)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, floats, ints,
         outcomes, restarts, results, counts, trajectory, first_rows):
-    model = CompiledModel({slots}, ints[8], ints[9] != 0, stress_in_lanes)
+    model = CompiledModel(
+        {slots}, ints[8], ints[9] != 0, stress_in_lanes, perforation_in_lanes,
+        branch_margins_in_lanes,
+    )
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
     scenes = lane_store.Batch(
         core, y, scale, constants, law_constants, floats[3], floats[4], ints[1] != 0,
         ints[2] != 0,
     )
     chunk, work, ev = lane_store.lanes_scratch(
-        tab, y.shape[1], ints[4], ints[6], outcomes.size, law_constants.shape[1]
+        tab, y.shape[1], ints[4], ints[6], outcomes.size, law_constants.shape[1],
+        constants.shape[1],
     )
     lanes.integrate_chunk(
         model, tab, chunk, work, ev, scenes, start, stop, ints[3], outcomes, restarts, ints[5],
@@ -89,7 +96,10 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
 def run_one_at_a_time(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P,
                       floats, ints, outcomes, restarts, results, counts, trajectory,
                       first_rows):
-    model = CompiledModel({slots}, ints[8], ints[9] != 0, stress_in_lanes)
+    model = CompiledModel(
+        {slots}, ints[8], ints[9] != 0, stress_in_lanes, perforation_in_lanes,
+        branch_margins_in_lanes,
+    )
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
     work, ev, known_margins = scene.scratch(tab, y.shape[1], ints[4], ints[6], outcomes.size)
     for i in range(start, stop):
@@ -194,7 +204,8 @@ _lane_kernels: dict[int, Callable[..., Any]] = {}
 
 def lane_kernel(function: Callable[..., Any]) -> Callable[..., Any]:
     """The inline copy of a plug-in's kernel that the lanes' vector loops call (once per
-    kernel and process): the law's stress, evaluated for every lane in one pass."""
+    kernel and process): the law's stress, the failure model's perforation and branch
+    margins, evaluated for every lane in one pass."""
     from numba.extending import register_jitable  # noqa: PLC0415
 
     if id(function) not in _lane_kernels:
