@@ -191,6 +191,39 @@ def test_auto_runs_compiled_whatever_the_size_and_chunking_changes_nothing():
     assert alone.exit_speed[0] == whole.exit_speed[17]
 
 
+@pytest.mark.parametrize("n", [1, 63, 64, 129, 1000, 10_007])
+@pytest.mark.parametrize("threads", [1, 2, 3])
+def test_strided_chunks_cover_every_scene_once(n, threads, monkeypatch):
+    """The threads' chunks (every C-th scene from each first scene) hand out each scene
+    exactly once, whatever the batch's size and the thread count."""
+    from plateimpact.solve.compiled import engine  # noqa: PLC0415
+
+    monkeypatch.setattr(engine, "_threads", [threads])
+    handed: list[int] = []
+    engine.run_parallel(lambda start, stop, step: handed.extend(range(start, stop, step)), n, ())
+    assert sorted(handed) == list(range(n))
+
+
+def test_one_thread_and_two_give_the_same_results_bit_for_bit(monkeypatch):
+    """Two threads take strided chunks of the batch (other neighbours in each lane, other
+    order): every result, count and trajectory equals one thread's, bit for bit."""
+    from plateimpact.solve.compiled import engine  # noqa: PLC0415
+
+    simulation = pi.Simulation.from_names(failure="plugging", engine="compiled")
+    scenes = batch(600, seed=12)
+    monkeypatch.setattr(engine, "_threads", [1])
+    one = simulation.run_batch(scenes, record_trajectory=True)
+    monkeypatch.setattr(engine, "_threads", [2])
+    two = simulation.run_batch(scenes, record_trajectory=True)
+    assert one.stats == two.stats
+    for name, column in one.columns.items():
+        np.testing.assert_array_equal(column, two.columns[name], err_msg=name)
+    for i in (0, 301, 599):
+        a, b = one.trajectory_of(i), two.trajectory_of(i)
+        for name in ("time", "penetration", "lateral", "obliquity", "speed"):
+            np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
 def test_numpy_only_settings_stay_on_the_numpy_path():
     fixed = pi.Simulation.from_names(
         failure="plugging", integrator_settings={"fixed_step": 0.01}, engine="auto"

@@ -45,7 +45,7 @@ def build(law: type[ResistanceLaw], failure: type[FailureModel]) -> ModuleType:
         with cache.compile_lock(key):
             compiled = program.program(law, failure)
             try:
-                compiled.run(0, 0, *signature_arguments())  # compiles, or loads the cache
+                compiled.run(0, 0, 1, *signature_arguments())  # compiles, or loads the cache
             except Exception as exc:  # numba's errors: the numpy path runs instead
                 said = str(exc).strip().splitlines()
                 reason = f"compiling failed ({type(exc).__name__}: {said[0] if said else ''})"

@@ -24,10 +24,13 @@ from ..recorder import ResultRecorder
 from . import scene
 from .building import build
 
-#: Scenes handed to a thread at a time: small enough to balance scenes of very different
-#: cost (a map's slow perforations beside its quick ricochets) over the cores, large
-#: enough that handing them out (some microseconds) costs nothing.
-PARALLEL_CHUNK = 256
+#: Chunks per thread. Each chunk is every C-th scene of the batch (C chunks), so chunks
+#: cost alike however a batch orders its scenes (a map's slow perforations lie side by
+#: side); threads take chunks as they finish them, so a core that other work slows takes
+#: fewer. Few chunks keep few lanes idle: a chunk's lanes idle as its last scenes end.
+CHUNKS_PER_THREAD = 4
+#: Fewest scenes in a chunk (a chunk steps 16 scenes together).
+MIN_CHUNK = 64
 _threads: list[int] = [0]  # 0: one per core
 
 
@@ -42,16 +45,17 @@ def threads() -> int:
 
 
 def run_parallel(run: Callable[..., None], n: int, arguments: tuple[Any, ...]) -> None:
-    """``run(start, stop, *arguments)`` over scenes 0 .. n − 1 in chunks, on the threads
-    (the compiled loop releases the GIL). A scene's result does not depend on its chunk
-    or thread: each writes only its own rows."""
-    chunks = [(lo, min(lo + PARALLEL_CHUNK, n)) for lo in range(0, n, PARALLEL_CHUNK)]
-    workers = min(threads(), len(chunks))
+    """``run(start, stop, step, *arguments)`` over scenes 0 .. n − 1 in strided chunks,
+    on the threads (the compiled loop releases the GIL). A scene's result does not depend
+    on its chunk or thread: each writes only its own rows."""
+    chunks = max(1, min(threads() * CHUNKS_PER_THREAD, n // MIN_CHUNK))
+    workers = min(threads(), chunks)
     if workers <= 1:
-        run(0, n, *arguments)
+        run(0, n, 1, *arguments)
         return
     with ThreadPoolExecutor(workers) as pool:
-        for future in [pool.submit(run, lo, hi, *arguments) for lo, hi in chunks]:
+        jobs = [pool.submit(run, first, n, chunks, *arguments) for first in range(chunks)]
+        for future in jobs:
             future.result()
 
 

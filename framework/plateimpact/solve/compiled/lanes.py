@@ -166,11 +166,11 @@ def write_rows(lanes: Lanes, lane: int, trajectory: Any) -> None:
 
 def integrate_chunk(
     model: CompiledModel, tab: Tableau, lanes: Lanes, work: StepWork, ev: EventWork,
-    scenes: Batch, start: int, stop: int,
-    max_steps: int, outcomes: Any, restarts: Any, embedment: int, results: Any, counts: Any,
-    writing: bool, trajectory: Any, first_rows: Any,
+    scenes: Batch, start: int, stop: int, step: int, max_steps: int, outcomes: Any,
+    restarts: Any, embedment: int, results: Any, counts: Any, writing: bool,
+    trajectory: Any, first_rows: Any,
 ) -> None:  # fmt: skip
-    """Scenes ``start`` .. ``stop`` − 1 into their rows of ``results`` and ``counts``
+    """Scenes ``range(start, stop, step)`` into their rows of ``results`` and ``counts``
     (as :func:`~.scene.integrate_scene` writes them), lanes refilled as scenes end."""
     value, flag = lanes.value, lanes.flag
     following = start
@@ -179,7 +179,7 @@ def integrate_chunk(
         if following < stop:
             enter(model, lanes, scenes, lane, following, writing, trajectory,
                   first_rows[following])  # fmt: skip
-            following += 1
+            following += step
     rows = lanes.at.size - 1  # a usual step's trajectory rows
     while True:
         busy = False
@@ -221,7 +221,7 @@ def integrate_chunk(
                 if following < stop:
                     enter(model, lanes, scenes, lane, following, writing, trajectory,
                           first_rows[following])  # fmt: skip
-                    following += 1
+                    following += step
 
 
 #: The functions of numbers a compiled path compiles (callees before callers).

@@ -71,8 +71,8 @@ branch_margins_in_lanes = program.lane_kernel(branch_margins)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, floats, ints,
-        outcomes, restarts, results, counts, trajectory, first_rows):
+def run(start, stop, step, core, y, scale, constants, law_constants, C, A, B, E, P, floats,
+        ints, outcomes, restarts, results, counts, trajectory, first_rows):
     model = CompiledModel(
         {slots}, ints[8], ints[9] != 0, stress_in_lanes, perforation_in_lanes,
         branch_margins_in_lanes,
@@ -87,14 +87,14 @@ def run(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P, fl
         constants.shape[1],
     )
     lanes.integrate_chunk(
-        model, tab, chunk, work, ev, scenes, start, stop, ints[3], outcomes, restarts, ints[5],
-        results, counts, ints[7] != 0, trajectory, first_rows,
+        model, tab, chunk, work, ev, scenes, start, stop, step, ints[3], outcomes, restarts,
+        ints[5], results, counts, ints[7] != 0, trajectory, first_rows,
     )
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def run_one_at_a_time(start, stop, core, y, scale, constants, law_constants, C, A, B, E, P,
-                      floats, ints, outcomes, restarts, results, counts, trajectory,
+def run_one_at_a_time(start, stop, step, core, y, scale, constants, law_constants, C, A, B,
+                      E, P, floats, ints, outcomes, restarts, results, counts, trajectory,
                       first_rows):
     model = CompiledModel(
         {slots}, ints[8], ints[9] != 0, stress_in_lanes, perforation_in_lanes,
@@ -102,7 +102,7 @@ def run_one_at_a_time(start, stop, core, y, scale, constants, law_constants, C, 
     )
     tab = Tableau(C, A, B, E, P, floats[0], floats[1], floats[2], ints[0] != 0)
     work, ev, known_margins = scene.scratch(tab, y.shape[1], ints[4], ints[6], outcomes.size)
-    for i in range(start, stop):
+    for i in range(start, stop, step):
         constants_i = SceneConstants(
             core[i, 0], core[i, 1], core[i, 2], core[i, 3], floats[3], floats[4],
             ints[1] != 0, ints[2] != 0, constants[i], law_constants[i],
