@@ -3,7 +3,8 @@ each skip saves.
 
   * the sweep on the compiled path (one thread, then one per core), on the numpy path,
     and through scipy's DOP853 (solve_ivp, one run) at the default rtol, on the same
-    scenes; the compiled path's results against the numpy path's;
+    scenes; the compiled path's results against the numpy path's; on every core against
+    the numpy path's process pool too;
   * the numpy sweep: minimum of 5 runs after a warm-up, in this process (the machine is
     shared: single runs vary by ±20%);
   * the same sweep spread over a 2-process pool (one chunk per core): warm, and including
@@ -41,8 +42,11 @@ def best_of(function, repeats=5):
     return min(times)
 
 
-def compiled_paths(batch: pi.SceneBatch, numpy_result: pi.BatchResult, numpy_time: float) -> None:
-    """The same sweep on the compiled path, on one thread and on every core."""
+def compiled_paths(
+    batch: pi.SceneBatch, numpy_result: pi.BatchResult, numpy_time: float, pool_time: float
+) -> None:
+    """The same sweep on the compiled path, on one thread and on every core, against the
+    numpy path in one process and (on every core) on its warm process pool."""
     from plateimpact.solve.compiled import engine
 
     compiled = attrs.evolve(pi.Simulation.from_names(), engine="compiled")
@@ -62,9 +66,10 @@ def compiled_paths(batch: pi.SceneBatch, numpy_result: pi.BatchResult, numpy_tim
     for threads in (1, os.cpu_count() or 1):
         engine.set_threads(threads)
         took = best_of(lambda: compiled.run_batch(batch))
+        pool = f", {pool_time / took:.1f}x its {threads}-process pool" if threads > 1 else ""
         print(
             f"  {threads} thread(s): {took:.3f} s ({took / batch.size * 1e6:.1f} us per "
-            f"scene), {numpy_time / took:.1f}x the numpy path"
+            f"scene), {numpy_time / took:.1f}x the numpy path{pool}"
         )
     engine.set_threads(0)
 
@@ -101,9 +106,6 @@ def main() -> None:
         f"({sweep / batch.size * 1e6:.0f} us per scene; ricochet/embedment/perforation "
         f"{'/'.join(map(str, counts))})"
     )
-    compiled_paths(batch, result, sweep)
-    scipy_reference(batch, result, sweep)
-
     workers = os.cpu_count() or 1
     chunk = -(-batch.size // workers)
     start = time.perf_counter()
@@ -116,6 +118,8 @@ def main() -> None:
         f"the same sweep on a {workers}-process pool: {warm:.2f} s warm, {cold:.2f} s "
         f"including the pool's start (results bit-identical)"
     )
+    compiled_paths(batch, result, sweep, warm)
+    scipy_reference(batch, result, sweep)
     per_scene = result.stats["force_evaluations"] / batch.size
     steps = (result.stats["accepted_steps"] + result.stats["rejected_steps"]) / batch.size
     print(
