@@ -136,7 +136,9 @@ def test_variable_pstar_moves_the_boundaries_the_way_the_report_says(obliquity):
     # ricochet range ends, and perforation starts, at lower impact speeds.
     speeds = np.arange(100.0, 1201.0, 20.0)
     batch = grid(STEEL, [obliquity], speeds)
-    constant, variable = run(batch, "plugging"), run(batch, "variable-pstar")
+    # the default integrator (the claim is the model's, not an integrator's)
+    constant = run(batch, "plugging", integrator="dopri5")
+    variable = run(batch, "variable-pstar", integrator="dopri5")
 
     def last_ricochet(r):
         return speeds[r.outcome == pi.Outcome.RICOCHET].max()
