@@ -137,7 +137,7 @@ def test_compiled_path_agrees_with_the_default_numpy(failure):
 
 
 def test_lanes_give_what_one_scene_at_a_time_gives_bit_for_bit(monkeypatch):
-    """The compiled path steps 16 scenes together (solve/compiled/lanes.py), each lane
+    """The compiled path steps 64 scenes together (solve/compiled/lanes.py), each lane
     doing the one-at-a-time driver's operations in its order: every result and count
     equal bit for bit, trajectories included, on the hinge (failure state, four branch
     rows, the finger) over every preset, with plates failing, the ring and all five

@@ -30,7 +30,7 @@ def plane_perforation_margin(
     """Depth [m] of the forward hemisphere's shallowest point below the failure plane at
     ``plane_depth`` h [m]: P − h − Rs(1 + sin min(θ, π/2)), >= 0 once the front layer no
     longer touches it (perforation); P [m], θ [rad], Rs [m], numbers or arrays. (sin from
-    :mod:`plateimpact.elementary`: the compiled path evaluates it for 16 scenes at once.)"""
+    :mod:`plateimpact.elementary`: the compiled path evaluates it for 64 scenes at once.)"""
     reach = radius * (1.0 + elementary.sin(np.minimum(obliquity, 0.5 * np.pi)))
     return penetration - plane_depth - reach
 

@@ -29,7 +29,7 @@ from .building import build
 #: side); threads take chunks as they finish them, so a core that other work slows takes
 #: fewer. Few chunks keep few lanes idle: a chunk's lanes idle as its last scenes end.
 CHUNKS_PER_THREAD = 4
-#: Fewest scenes in a chunk (a chunk steps 16 scenes together).
+#: Fewest scenes in a chunk (a chunk steps WIDTH = 64 scenes together).
 MIN_CHUNK = 64
 _threads: list[int] = [0]  # 0: one per core
 

@@ -3,7 +3,7 @@ every lane at once, stored lane-major (``src[row, lane]``), calling the same for
 
 Each loop over the lanes calls only inlined, branch-free code (the geometry's eq-6 branch
 and :mod:`plateimpact.elementary`'s functions), so LLVM vectorises it: a pass over the
-16 lanes costs a few scenes' worth. The relieved force of a failed plate (eqs 9–15) is a
+lanes costs a few scenes' worth. The relieved force of a failed plate (eqs 9–15) is a
 second such pass. The law's stress is an inline copy of its kernel on each lane's
 constants (lane-major), in the same loop. What only some lanes need is then done lane
 by lane by the scalar kernels: what a failure model adds

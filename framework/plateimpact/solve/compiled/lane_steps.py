@@ -1,5 +1,5 @@
 """One step of every lane: :mod:`.stepping`'s propose, advance and judge and the step's
-samples, for the 16 lanes at once, in the same order of operations per lane (so a
+samples, for all the lanes at once, in the same order of operations per lane (so a
 lane takes the scalar path's steps, bit for bit).
 
 Loops run over the lanes innermost, on lane-major arrays, so that LLVM vectorises them;

@@ -15,9 +15,13 @@ from .events import EventWork
 from .motion import SceneConstants
 from .stepping import StepWork, Tableau
 
-#: Scenes stepped side by side: the widest vector of doubles (AVX-512); narrower
-#: machines run two or four vector operations per loop.
-WIDTH = 16
+#: Scenes stepped side by side: eight vectors of doubles (AVX-512) a loop. Every loop
+#: over the lanes and every call between the lane functions costs a fixed overhead
+#: (arguments, the runtime check that arrays do not overlap, the loop's set-up) besides
+#: its arithmetic; 64 lanes share it four times as widely as 16: 29.4 -> 18.0 us a scene
+#: on the benchmark (docs/integrators.md, "Sixty-four lanes"), at the cost of batches of
+#: a few dozen scenes, whose idle lanes compute too.
+WIDTH = 64
 #: Rows of ``Lanes.counts``: each lane's steps, accepted and rejected steps, force
 #: evaluations and next trajectory row.
 N_STEPS, N_ACCEPTED, N_REJECTED, N_EVALUATIONS, ROW = range(5)

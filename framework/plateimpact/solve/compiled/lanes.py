@@ -1,4 +1,4 @@
-"""Scenes stepped 16 at a time: the compiled path's batch loop.
+"""Scenes stepped 64 at a time: the compiled path's batch loop.
 
 Each lane holds one scene; every lane takes its own steps (its own size, acceptance and
 events), but the lanes take them together, so the work of a step (the stages' forces,
