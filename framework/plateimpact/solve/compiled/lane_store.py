@@ -104,7 +104,6 @@ class Lanes(NamedTuple):
     one_state: Any
     one_rate: Any
     one_branch: Any
-    one_event: Any
 
 
 def lanes_scratch(
@@ -138,7 +137,7 @@ def lanes_scratch(
         np.zeros((q, width, n)), np.zeros((branch_rows, n)), np.zeros((branch_rows, n)),
         np.zeros((branch_rows, n), np.bool_), at, np.zeros((at.size, width, n)),
         np.zeros((at.size, events, n)), np.zeros((6, n)), np.zeros((6, n)),
-        np.zeros(width), np.zeros(width), np.zeros(branch_rows), np.zeros(events),
+        np.zeros(width), np.zeros(width), np.zeros(branch_rows),
     )  # fmt: skip
     return lanes, work, ev
 
