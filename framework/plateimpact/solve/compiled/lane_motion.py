@@ -4,12 +4,12 @@ every lane at once, stored lane-major (``src[row, lane]``), calling the same for
 Each loop over the lanes calls only inlined, branch-free code (the geometry's eq-6 branch
 and :mod:`plateimpact.elementary`'s functions), so LLVM vectorises it: a pass over the
 lanes costs a few scenes' worth. The relieved force of a failed plate (eqs 9–15) is a
-second such pass. The law's stress is an inline copy of its kernel on each lane's
-constants (lane-major), in the same loop. What only some lanes need is then done lane
-by lane by the scalar kernels: what a failure model adds
-on top of its relief, the failure state's rates, and the turn-around ring of eq 6, which
-the scalar rates redo whole. A lane's numbers are therefore the scalar path's, bit for
-bit (tested).
+second such pass. The law's stress and a failed plate's perforation and branch margins
+are inline copies of the plug-ins' kernels on each lane's constants (lane-major), in the
+same loops. What only some lanes need is then done lane by lane by the scalar kernels:
+what a failure model adds on top of its relief, the failure state's rates, and the
+turn-around ring of eq 6, which the scalar rates redo whole. A lane's numbers are
+therefore the scalar path's, bit for bit (tested).
 
 ``lanes`` is a :class:`~.lane_store.Lanes`; ``scenes`` a :class:`~.lane_store.Batch` of
 the batch's columns.
