@@ -1,15 +1,24 @@
 """Archive writers: never a lost run, never a replaced file, never a second writer; failures
-injected deterministically at each stage of an append (storage.append.fault_point)."""
+injected deterministically at each stage of an append (storage.append.fault_point).
+
+Writers that must be other processes (killed, or racing this one for the lock) are forked
+from this one (:class:`Forked`): as separate as a subprocess, without the second of CPU a
+new interpreter spends importing plateimpact."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import signal
 import stat
 import subprocess
 import sys
+import tempfile
 import threading
+import traceback
+import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import h5py
@@ -35,6 +44,61 @@ def tiny_result() -> pi.BatchResult:
 def make_archive(path: Path) -> bytes:
     tiny_study().run(archive=path)
     return path.read_bytes()
+
+
+class Forked:
+    """``work()`` run in a child forked from this process, as separate a writer as a
+    subprocess (its own descriptors, locks and module state; a kill or a crash ends it
+    alone), with everything this process has imported. Its standard output and error
+    are captured at file descriptors 1 and 2 (libhdf5's own messages too), warnings
+    printed there as an interpreter prints them. Fork it before starting threads."""
+
+    def __init__(self, work: Callable[[], object]) -> None:
+        self.out, self.err = tempfile.TemporaryFile(), tempfile.TemporaryFile()
+        self.pid = os.fork()
+        if self.pid == 0:  # the child: leaves only through os._exit, never into pytest
+            code = 1
+            try:
+                os.dup2(self.out.fileno(), 1)
+                os.dup2(self.err.fileno(), 2)
+                sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115 (never closed)
+                sys.stderr = open(2, "w", closefd=False)  # noqa: SIM115
+                warnings.showwarning = _print_warning  # not into pytest's record
+                work()
+                code = 0
+            except SystemExit as exc:  # as the interpreter ends on it
+                code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+                if not isinstance(exc.code, int | None):
+                    print(exc.code, file=sys.stderr)
+            except BaseException:  # noqa: BLE001 (the parent sees exit 1 and the traceback)
+                traceback.print_exc()
+            finally:
+                with contextlib.suppress(BaseException):
+                    sys.stdout.flush()
+                    sys.stderr.flush()
+                os._exit(code)
+
+    def wait(self) -> subprocess.CompletedProcess[str]:
+        """The child's end: returncode -N if signal N ended it, else its exit code (0:
+        ``work`` returned; 1: it raised, the traceback in stderr), and what it printed."""
+        status = os.waitpid(self.pid, 0)[1]
+        printed = []
+        for captured in (self.out, self.err):
+            with captured:
+                captured.seek(0)
+                printed.append(captured.read().decode(errors="replace"))
+        return subprocess.CompletedProcess(
+            [], os.waitstatus_to_exitcode(status), printed[0], printed[1]
+        )
+
+
+def forked(work: Callable[[], object]) -> subprocess.CompletedProcess[str]:
+    """``work()`` run to its end in a forked child (:class:`Forked`)."""
+    return Forked(work).wait()
+
+
+def _print_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 def debris(directory: Path) -> list[str]:
@@ -75,27 +139,26 @@ def test_a_failed_append_leaves_the_archive_as_it_was(tmp_path, stage, monkeypat
     assert set(pi.Archive(path).runs()) == {"w/v", "w/x"}  # and the lock was let go
 
 
-KILLED_APPENDER = """
-import os, signal, sys
-import numpy as np
-import plateimpact as pi
-from plateimpact.storage import append
-study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
-result = study.run()["v"]
-def die(stage):
-    if stage == sys.argv[2]:
-        os.kill(os.getpid(), signal.SIGKILL)
-append.fault_point = die
-pi.Archive(sys.argv[1]).append_run(study, pi.Variant("killed"), result, {"note": "x"})
-"""
+def killed_appender(path: Path, stage: str, result: pi.BatchResult) -> int:
+    """The returncode of a forked writer that appends ``result`` to ``path`` as run
+    ``killed`` and SIGKILLs itself at the fault point ``stage``."""
+
+    def die(where: str) -> None:
+        if where == stage:
+            os.kill(os.getpid(), signal.SIGKILL)
+
+    def append() -> None:
+        appending.fault_point = die  # the child's module: this process's is untouched
+        pi.Archive(path).append_run(tiny_study(), pi.Variant("killed"), result, {"note": "x"})
+
+    return forked(append).returncode
 
 
 @pytest.mark.parametrize("stage", STAGES)
 def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stage, tiny_result):
     path = tmp_path / "a.h5"
     before = make_archive(path)
-    done = subprocess.run([sys.executable, "-c", KILLED_APPENDER, str(path), stage])
-    assert done.returncode == -signal.SIGKILL
+    assert killed_appender(path, stage, tiny_result) == -signal.SIGKILL
     assert path.read_bytes() == before and pi.Archive(path).runs() == ["w/v"]
     # Killed once its data file was complete, it leaves that file unnamed by the index:
     # no reader sees it, and the next writer removes it.
@@ -129,8 +192,7 @@ def test_a_failure_letting_go_of_the_lock_keeps_the_run_says_so_and_frees_the_lo
 def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_path, tiny_result):
     path = tmp_path / "a.h5"
     make_archive(path)
-    done = subprocess.run([sys.executable, "-c", KILLED_APPENDER, str(path), "unlock"])
-    assert done.returncode == -signal.SIGKILL
+    assert killed_appender(path, "unlock", tiny_result) == -signal.SIGKILL
     assert set(pi.Archive(path).runs()) == {"w/v", "w/killed"}
     np.testing.assert_array_equal(
         pi.Archive(path).results("killed").exit_speed, tiny_result.exit_speed
@@ -140,18 +202,6 @@ def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_pa
     assert len(pi.Archive(path).runs()) == 3 and debris(tmp_path) == []
 
 
-RACER = """
-import sys
-import numpy as np
-import plateimpact as pi
-study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
-result = study.run()["v"]
-for k in range(3):  # waiting as long as it takes: no clock decides where a run goes
-    archive = pi.Archive(sys.argv[1], wait=float("inf"))
-    archive.append_run(study, pi.Variant(f"p{sys.argv[2]}r{k}"), result, {"n": k})
-"""
-
-
 @pytest.mark.filterwarnings("ignore::plateimpact.base.errors.ArchiveWaitWarning")
 def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
     path = tmp_path / "a.h5"
@@ -159,9 +209,14 @@ def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
     make_archive(path)
     link.symlink_to(path)  # half the threads write through a link: one lock, one file
     study = tiny_study()
-    processes = [
-        subprocess.Popen([sys.executable, "-c", RACER, str(path), str(p)]) for p in range(4)
-    ]
+
+    def racer(p: int) -> None:
+        for k in range(3):  # waiting as long as it takes: no clock decides where a run goes
+            archive = pi.Archive(path, wait=math.inf)
+            archive.append_run(study, pi.Variant(f"p{p}r{k}"), tiny_result, {"n": k})
+
+    # forked before the threads start: a fork copies no lock another thread holds
+    processes = [Forked(lambda p=p: racer(p)) for p in range(4)]
     errors: list[BaseException] = []
 
     def appender(t: int) -> None:
@@ -177,7 +232,9 @@ def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
         thread.start()
     for thread in threads:
         thread.join()
-    assert [p.wait() for p in processes] == [0, 0, 0, 0] and errors == []
+    ended = [p.wait() for p in processes]
+    assert [p.returncode for p in ended] == [0, 0, 0, 0], [p.stderr for p in ended]
+    assert errors == []
     runs = pi.Archive(path).runs()
     expected = {f"w/t{t}r{k}" for t in range(8) for k in range(3)}
     expected |= {f"w/p{p}r{k}" for p in range(4) for k in range(3)}
