@@ -51,14 +51,18 @@ class Forked:
     subprocess (its own descriptors, locks and module state; a kill or a crash ends it
     alone), with everything this process has imported. Its standard output and error
     are captured at file descriptors 1 and 2 (libhdf5's own messages too), warnings
-    printed there as an interpreter prints them. Fork it before starting threads."""
+    printed there as an interpreter prints them. A child still running after ``timeout``
+    seconds is ended by SIGALRM (a hang fails the test instead of stopping the suite).
+    Fork it before starting threads."""
 
-    def __init__(self, work: Callable[[], object]) -> None:
+    def __init__(self, work: Callable[[], object], timeout: int = 600) -> None:
         self.out, self.err = tempfile.TemporaryFile(), tempfile.TemporaryFile()
         self.pid = os.fork()
         if self.pid == 0:  # the child: leaves only through os._exit, never into pytest
             code = 1
             try:
+                signal.signal(signal.SIGALRM, signal.SIG_DFL)
+                signal.alarm(timeout)
                 os.dup2(self.out.fileno(), 1)
                 os.dup2(self.err.fileno(), 2)
                 sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115 (never closed)
