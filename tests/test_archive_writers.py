@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import shutil
 import signal
 import stat
 import subprocess
@@ -41,9 +42,20 @@ def tiny_result() -> pi.BatchResult:
     return tiny_study().run()["v"]
 
 
-def make_archive(path: Path) -> bytes:
-    tiny_study().run(archive=path)
-    return path.read_bytes()
+@pytest.fixture(scope="module")
+def make_archive(tmp_path_factory) -> Callable[[Path], bytes]:
+    """The tiny study's archive (run w/v) written once; ``make_archive(path)`` copies it
+    to ``path`` (named a.h5, as it is) with its data directory and lock file and returns
+    the index's bytes (what is tested is what writers do to it, not its first write)."""
+    start = tmp_path_factory.mktemp("start")
+    tiny_study().run(archive=start / "a.h5")
+
+    def make(path: Path) -> bytes:
+        assert path.name == "a.h5", path
+        shutil.copytree(start, path.parent, dirs_exist_ok=True)
+        return path.read_bytes()
+
+    return make
 
 
 class Forked:
@@ -125,7 +137,9 @@ def debris(directory: Path) -> list[str]:
 
 
 @pytest.mark.parametrize("stage", STAGES)
-def test_a_failed_append_leaves_the_archive_as_it_was(tmp_path, stage, monkeypatch, tiny_result):
+def test_a_failed_append_leaves_the_archive_as_it_was(
+    tmp_path, stage, monkeypatch, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     before = make_archive(path)
 
@@ -159,7 +173,9 @@ def killed_appender(path: Path, stage: str, result: pi.BatchResult) -> int:
 
 
 @pytest.mark.parametrize("stage", STAGES)
-def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stage, tiny_result):
+def test_an_appender_killed_at_any_stage_keeps_every_finished_run(
+    tmp_path, stage, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     before = make_archive(path)
     assert killed_appender(path, stage, tiny_result) == -signal.SIGKILL
@@ -173,7 +189,7 @@ def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stag
 
 
 def test_a_failure_letting_go_of_the_lock_keeps_the_run_says_so_and_frees_the_lock(
-    tmp_path, monkeypatch, tiny_result
+    tmp_path, monkeypatch, tiny_result, make_archive
 ):
     path = tmp_path / "a.h5"
     make_archive(path)
@@ -193,7 +209,9 @@ def test_a_failure_letting_go_of_the_lock_keeps_the_run_says_so_and_frees_the_lo
     assert set(pi.Archive(path).runs()) == {"w/v", "w/x", "w/y"}
 
 
-def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_path, tiny_result):
+def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(
+    tmp_path, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     make_archive(path)
     assert killed_appender(path, "unlock", tiny_result) == -signal.SIGKILL
@@ -207,7 +225,7 @@ def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_pa
 
 
 @pytest.mark.filterwarnings("ignore::plateimpact.base.errors.ArchiveWaitWarning")
-def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
+def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result, make_archive):
     path = tmp_path / "a.h5"
     link = tmp_path / "link.h5"
     make_archive(path)
@@ -256,7 +274,7 @@ def test_a_wait_that_is_no_number_of_seconds_is_refused(tmp_path, wait):
         pi.Archive(tmp_path / "a.h5", wait=wait)
 
 
-def test_an_archive_and_an_output_keep_their_owner(tmp_path):
+def test_an_archive_and_an_output_keep_their_owner(tmp_path, make_archive):
     if os.geteuid() != 0:
         pytest.skip("giving a file to another user needs root")
     path, csv = tmp_path / "a.h5", tmp_path / "s.csv"
@@ -273,7 +291,9 @@ def test_an_archive_and_an_output_keep_their_owner(tmp_path):
     assert len(pi.Archive(path).runs()) == 2 and csv.read_text().startswith("preset,")
 
 
-def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(tmp_path, tiny_result):
+def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(
+    tmp_path, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     make_archive(path)
     path.chmod(0o640)
@@ -289,7 +309,7 @@ def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(tmp_
     assert path.read_bytes() == before
 
 
-def test_an_archive_of_another_format_version_is_refused(tmp_path):
+def test_an_archive_of_another_format_version_is_refused(tmp_path, make_archive):
     path = tmp_path / "a.h5"
     make_archive(path)
     with h5py.File(path, "a") as f:
@@ -303,7 +323,7 @@ def test_an_archive_of_another_format_version_is_refused(tmp_path):
     assert path.read_bytes() == before
 
 
-def test_a_group_without_its_seal_is_damaged(tmp_path):
+def test_a_group_without_its_seal_is_damaged(tmp_path, make_archive):
     path = tmp_path / "a.h5"
     make_archive(path)
     with h5py.File(path, "a") as f:
@@ -336,7 +356,7 @@ def test_show_of_what_is_not_an_archive_file_is_one_line(argument, words, tmp_pa
     assert_one_line(code, err, words)
 
 
-def test_a_full_disk_during_an_append_keeps_the_archive_and_is_one_line(tmp_path):
+def test_a_full_disk_during_an_append_keeps_the_archive_and_is_one_line(tmp_path, make_archive):
     with mounted(tmp_path, "size=256k") as disk:
         path = disk / "a.h5"
         before = make_archive(path)
