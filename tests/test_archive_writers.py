@@ -42,12 +42,11 @@ def tiny_result() -> pi.BatchResult:
     return tiny_study().run()["v"]
 
 
-@pytest.fixture(scope="module")
-def make_archive(tmp_path_factory) -> Callable[[Path], bytes]:
-    """The tiny study's archive (run w/v) written once; ``make_archive(path)`` copies it
-    to ``path`` (named a.h5, as it is) with its data directory and lock file and returns
-    the index's bytes (what is tested is what writers do to it, not its first write)."""
-    start = tmp_path_factory.mktemp("start")
+def archive_maker(start: Path) -> Callable[[Path], bytes]:
+    """The tiny study's archive (run w/v) written once into the directory ``start``;
+    the function returned copies it to a path (named a.h5, as it is) with its data
+    directory and lock file and returns the index's bytes (what writer tests test is
+    what writers do to an archive, not its first write: tests/test_archive.py)."""
     tiny_study().run(archive=start / "a.h5")
 
     def make(path: Path) -> bytes:
@@ -56,6 +55,11 @@ def make_archive(tmp_path_factory) -> Callable[[Path], bytes]:
         return path.read_bytes()
 
     return make
+
+
+@pytest.fixture(scope="module")
+def make_archive(tmp_path_factory) -> Callable[[Path], bytes]:
+    return archive_maker(tmp_path_factory.mktemp("start"))
 
 
 class Forked:
