@@ -8,6 +8,7 @@ new interpreter spends importing plateimpact."""
 from __future__ import annotations
 
 import contextlib
+import faulthandler
 import math
 import os
 import shutil
@@ -84,6 +85,7 @@ class Forked:
                 sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115 (never closed)
                 sys.stderr = open(2, "w", closefd=False)  # noqa: SIM115
                 warnings.showwarning = _print_warning  # not into pytest's record
+                faulthandler.disable()  # pytest's prints a crash to the terminal
                 work()
                 code = 0
             except SystemExit as exc:  # as the interpreter ends on it
