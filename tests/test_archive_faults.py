@@ -2,7 +2,7 @@
 full one is a plain one-line error, never a crash), an upgrade holds the lock and
 completes when rerun after a kill at any stage, and names too long or a read-only
 filesystem are one line naming the flag, before any work. Kills are deterministic:
-a forked writer SIGKILLs itself at a named fault point."""
+a forked writer SIGKILLs itself at a named fault point (test_archive_writers.forked)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import os
 import shutil
 import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import h5py
@@ -20,6 +19,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from test_archive import assert_same
+from test_archive_writers import forked
 from test_output_files import assert_one_line, mounted, run_cli
 from test_output_flags import CALIBRATE, SCENE
 
@@ -92,58 +92,52 @@ def test_a_data_file_made_in_memory_reads_as_one_written_to_a_path(tmp_path):
         xr.testing.assert_identical(ours, direct)
 
 
-FILL = """
-import os, shutil, sys
-import numpy as np
-import plateimpact as pi
-from plateimpact import limits, presets
-from plateimpact.storage.upgrade import upgrade
-disk, format1 = sys.argv[1], sys.argv[2]
-found = limits.along_speed(
-    pi.Simulation.from_names(), presets.DEFAULT_SPHERE, presets.plate("2024-T3/3.18"),
-    np.radians([30.0]), (200.0, 800.0), resolution=100.0,
-)
-def study(variant):
-    return pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]),
-                         pi.Variant(variant))
-for mode in ("append", "limits", "upgrade"):
-    for left in (0, 8192, 12288, 20480, 40960):
-        for name in os.listdir(disk):
-            shutil.rmtree(os.path.join(disk, name), ignore_errors=True)
-            if os.path.exists(os.path.join(disk, name)):
-                os.unlink(os.path.join(disk, name))
-        archive = os.path.join(disk, "a.h5")
-        if mode == "upgrade":
-            shutil.copyfile(format1, archive)
-        else:
-            study("v").run(archive=archive)
-        before = open(archive, "rb").read()
-        free = os.statvfs(disk).f_bavail * os.statvfs(disk).f_frsize
-        with open(os.path.join(disk, "filler"), "wb") as filler:
-            filler.write(bytes(max(free - left, 0)))
-        try:
-            if mode == "append":
-                study("x").run(archive=archive, record_trajectory=True)
-            elif mode == "limits":
-                limits.archive_limits(archive, "l", found)
+def fill_and_write(disk: Path, found: limits.Limits) -> None:
+    """On ``disk`` filled to within 0-40 KiB of full, each kind of write: a line each of
+    what happened (mode, bytes left, the archive's bytes unchanged, runs readable at its
+    path, the error's text or ''). The archive each append and limits starts from is
+    written once, beside the disk, and copied onto it (index, data files and lock)."""
+    start = disk.parent / "start"
+    start.mkdir()
+    tiny_study().run(archive=start / "a.h5")
+    for mode in ("append", "limits", "upgrade"):
+        for left in (0, 8192, 12288, 20480, 40960):
+            for entry in disk.iterdir():  # the last case's archive and filler
+                if entry.is_dir():
+                    shutil.rmtree(entry)
+                else:
+                    entry.unlink()
+            archive = disk / "a.h5"
+            if mode == "upgrade":
+                shutil.copyfile(FORMAT1, archive)
             else:
-                upgrade(archive, registry=pi.default_registry())
-            error = ""
-        except pi.ArchiveError as exc:
-            error = str(exc)
-        same = open(archive, "rb").read() == before
-        print(mode, left, same, pi.Archive(archive).runs() != [], repr(error), flush=True)
-"""
+                shutil.copytree(start, disk, dirs_exist_ok=True)
+            before = archive.read_bytes()
+            free = os.statvfs(disk).f_bavail * os.statvfs(disk).f_frsize
+            with open(disk / "filler", "wb") as filler:
+                filler.write(bytes(max(free - left, 0)))
+            try:
+                if mode == "append":
+                    tiny_study("x").run(archive=archive, record_trajectory=True)
+                elif mode == "limits":
+                    limits.archive_limits(archive, "l", found)
+                else:
+                    upgrading.upgrade(archive, registry=pi.default_registry())
+                error = ""
+            except pi.ArchiveError as exc:
+                error = str(exc)
+            same = archive.read_bytes() == before
+            print(mode, left, same, pi.Archive(archive).runs() != [], repr(error), flush=True)
 
 
-def test_a_full_disk_at_any_fill_is_one_line_and_keeps_the_archive(tmp_path):
+def test_a_full_disk_at_any_fill_is_one_line_and_keeps_the_archive(tmp_path, found):
     """Appends, stored limits and upgrades on a disk filled to within 0-40 KiB, where
     libhdf5's own writes used to crash the process (exit 139 after 90 lines of
     tracebacks; an upgrade left the archive's path empty): a one-line ArchiveError and
-    the archive as it was, or the work done. (In a subprocess: a crash is a result.)"""
+    the archive as it was, or the work done. (In a forked child: a crash is a result,
+    and what libhdf5 prints is in its stderr.)"""
     with mounted(tmp_path, "size=512k") as disk:
-        done = subprocess.run([sys.executable, "-c", FILL, str(disk), str(FORMAT1)],
-                              capture_output=True, text=True, timeout=600)  # fmt: skip
+        done = forked(lambda: fill_and_write(disk, found))
         assert done.returncode == 0, done.stderr[-3000:]
         lines = done.stdout.splitlines()
         assert len(lines) == 15 and not done.stderr, done.stdout + done.stderr[-3000:]
@@ -186,23 +180,20 @@ def test_an_upgrade_waits_for_the_archives_writer(tmp_path):
 
 
 def _killed_at(stage: str, path: Path, nth: int = 1) -> int:
-    """Fork a writer that upgrades ``path`` and SIGKILLs itself at the ``nth`` call of
-    the fault point ``stage``; its wait status."""
-    pid = os.fork()
-    if pid == 0:  # the child: never returns
-        try:
-            calls = [0]
+    """The returncode of a writer (forked from this process) that upgrades ``path`` and
+    SIGKILLs itself at the ``nth`` call of the fault point ``stage``."""
+    calls = [0]
 
-            def die(where: str) -> None:
-                calls[0] += where == stage
-                if where == stage and calls[0] == nth:
-                    os.kill(os.getpid(), signal.SIGKILL)
+    def die(where: str) -> None:
+        calls[0] += where == stage
+        if where == stage and calls[0] == nth:
+            os.kill(os.getpid(), signal.SIGKILL)
 
-            upgrading.fault_point = die
-            upgrading.upgrade(path, registry=pi.default_registry())
-        finally:
-            os._exit(0)
-    return os.waitpid(pid, 0)[1]
+    def upgrade() -> None:
+        upgrading.fault_point = die  # the child's module: this process's is untouched
+        upgrading.upgrade(path, registry=pi.default_registry())
+
+    return forked(upgrade).returncode
 
 
 @pytest.mark.parametrize("stage", UPGRADE_STAGES)
@@ -210,8 +201,8 @@ def test_an_upgrade_killed_at_any_stage_leaves_an_archive_and_a_rerun_completes(
     path = tmp_path / "old.h5"
     shutil.copyfile(FORMAT1, path)
     original = pi.Archive(FORMAT1)
-    status = _killed_at(stage, path, nth=2 if stage == "run" else 1)  # "run": 2 runs of 3
-    assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGKILL
+    returncode = _killed_at(stage, path, nth=2 if stage == "run" else 1)  # "run": 2 runs of 3
+    assert returncode == -signal.SIGKILL
     assert pi.Archive(path).runs() == original.runs()  # an archive at the path, whole
     if stage != "replaced":
         assert pi.Archive(path).version() == 1 and path.read_bytes() == FORMAT1.read_bytes()

@@ -1,15 +1,26 @@
 """Archive writers: never a lost run, never a replaced file, never a second writer; failures
-injected deterministically at each stage of an append (storage.append.fault_point)."""
+injected deterministically at each stage of an append (storage.append.fault_point).
+
+Writers that must be other processes (killed, or racing this one for the lock) are forked
+from this one (:class:`Forked`): as separate as a subprocess, without the second of CPU a
+new interpreter spends importing plateimpact."""
 
 from __future__ import annotations
 
+import contextlib
+import faulthandler
 import math
 import os
+import shutil
 import signal
 import stat
 import subprocess
 import sys
+import tempfile
 import threading
+import traceback
+import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import h5py
@@ -32,9 +43,84 @@ def tiny_result() -> pi.BatchResult:
     return tiny_study().run()["v"]
 
 
-def make_archive(path: Path) -> bytes:
-    tiny_study().run(archive=path)
-    return path.read_bytes()
+def archive_maker(start: Path) -> Callable[[Path], bytes]:
+    """The tiny study's archive (run w/v) written once into the directory ``start``;
+    the function returned copies it to a path (named a.h5, as it is) with its data
+    directory and lock file and returns the index's bytes (what writer tests test is
+    what writers do to an archive, not its first write: tests/test_archive.py)."""
+    tiny_study().run(archive=start / "a.h5")
+
+    def make(path: Path) -> bytes:
+        assert path.name == "a.h5", path
+        shutil.copytree(start, path.parent, dirs_exist_ok=True)
+        return path.read_bytes()
+
+    return make
+
+
+@pytest.fixture(scope="module")
+def make_archive(tmp_path_factory) -> Callable[[Path], bytes]:
+    return archive_maker(tmp_path_factory.mktemp("start"))
+
+
+class Forked:
+    """``work()`` run in a child forked from this process, as separate a writer as a
+    subprocess (its own descriptors, locks and module state; a kill or a crash ends it
+    alone), with everything this process has imported. Its standard output and error
+    are captured at file descriptors 1 and 2 (libhdf5's own messages too), warnings
+    printed there as an interpreter prints them. A child still running after ``timeout``
+    seconds is ended by SIGALRM (a hang fails the test instead of stopping the suite).
+    Fork it before starting threads."""
+
+    def __init__(self, work: Callable[[], object], timeout: int = 600) -> None:
+        self.out, self.err = tempfile.TemporaryFile(), tempfile.TemporaryFile()
+        self.pid = os.fork()
+        if self.pid == 0:  # the child: leaves only through os._exit, never into pytest
+            code = 1
+            try:
+                signal.signal(signal.SIGALRM, signal.SIG_DFL)
+                signal.alarm(timeout)
+                os.dup2(self.out.fileno(), 1)
+                os.dup2(self.err.fileno(), 2)
+                sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115 (never closed)
+                sys.stderr = open(2, "w", closefd=False)  # noqa: SIM115
+                warnings.showwarning = _print_warning  # not into pytest's record
+                faulthandler.disable()  # pytest's prints a crash to the terminal
+                work()
+                code = 0
+            except SystemExit as exc:  # as the interpreter ends on it
+                code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+                if not isinstance(exc.code, int | None):
+                    print(exc.code, file=sys.stderr)
+            except BaseException:  # noqa: BLE001 (the parent sees exit 1 and the traceback)
+                traceback.print_exc()
+            finally:
+                with contextlib.suppress(BaseException):
+                    sys.stdout.flush()
+                    sys.stderr.flush()
+                os._exit(code)
+
+    def wait(self) -> subprocess.CompletedProcess[str]:
+        """The child's end: returncode -N if signal N ended it, else its exit code (0:
+        ``work`` returned; 1: it raised, the traceback in stderr), and what it printed."""
+        status = os.waitpid(self.pid, 0)[1]
+        printed = []
+        for captured in (self.out, self.err):
+            with captured:
+                captured.seek(0)
+                printed.append(captured.read().decode(errors="replace"))
+        return subprocess.CompletedProcess(
+            [], os.waitstatus_to_exitcode(status), printed[0], printed[1]
+        )
+
+
+def forked(work: Callable[[], object]) -> subprocess.CompletedProcess[str]:
+    """``work()`` run to its end in a forked child (:class:`Forked`)."""
+    return Forked(work).wait()
+
+
+def _print_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 def debris(directory: Path) -> list[str]:
@@ -57,7 +143,9 @@ def debris(directory: Path) -> list[str]:
 
 
 @pytest.mark.parametrize("stage", STAGES)
-def test_a_failed_append_leaves_the_archive_as_it_was(tmp_path, stage, monkeypatch, tiny_result):
+def test_a_failed_append_leaves_the_archive_as_it_was(
+    tmp_path, stage, monkeypatch, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     before = make_archive(path)
 
@@ -75,27 +163,28 @@ def test_a_failed_append_leaves_the_archive_as_it_was(tmp_path, stage, monkeypat
     assert set(pi.Archive(path).runs()) == {"w/v", "w/x"}  # and the lock was let go
 
 
-KILLED_APPENDER = """
-import os, signal, sys
-import numpy as np
-import plateimpact as pi
-from plateimpact.storage import append
-study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
-result = study.run()["v"]
-def die(stage):
-    if stage == sys.argv[2]:
-        os.kill(os.getpid(), signal.SIGKILL)
-append.fault_point = die
-pi.Archive(sys.argv[1]).append_run(study, pi.Variant("killed"), result, {"note": "x"})
-"""
+def killed_appender(path: Path, stage: str, result: pi.BatchResult) -> int:
+    """The returncode of a forked writer that appends ``result`` to ``path`` as run
+    ``killed`` and SIGKILLs itself at the fault point ``stage``."""
+
+    def die(where: str) -> None:
+        if where == stage:
+            os.kill(os.getpid(), signal.SIGKILL)
+
+    def append() -> None:
+        appending.fault_point = die  # the child's module: this process's is untouched
+        pi.Archive(path).append_run(tiny_study(), pi.Variant("killed"), result, {"note": "x"})
+
+    return forked(append).returncode
 
 
 @pytest.mark.parametrize("stage", STAGES)
-def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stage, tiny_result):
+def test_an_appender_killed_at_any_stage_keeps_every_finished_run(
+    tmp_path, stage, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     before = make_archive(path)
-    done = subprocess.run([sys.executable, "-c", KILLED_APPENDER, str(path), stage])
-    assert done.returncode == -signal.SIGKILL
+    assert killed_appender(path, stage, tiny_result) == -signal.SIGKILL
     assert path.read_bytes() == before and pi.Archive(path).runs() == ["w/v"]
     # Killed once its data file was complete, it leaves that file unnamed by the index:
     # no reader sees it, and the next writer removes it.
@@ -106,7 +195,7 @@ def test_an_appender_killed_at_any_stage_keeps_every_finished_run(tmp_path, stag
 
 
 def test_a_failure_letting_go_of_the_lock_keeps_the_run_says_so_and_frees_the_lock(
-    tmp_path, monkeypatch, tiny_result
+    tmp_path, monkeypatch, tiny_result, make_archive
 ):
     path = tmp_path / "a.h5"
     make_archive(path)
@@ -126,11 +215,12 @@ def test_a_failure_letting_go_of_the_lock_keeps_the_run_says_so_and_frees_the_lo
     assert set(pi.Archive(path).runs()) == {"w/v", "w/x", "w/y"}
 
 
-def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_path, tiny_result):
+def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(
+    tmp_path, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     make_archive(path)
-    done = subprocess.run([sys.executable, "-c", KILLED_APPENDER, str(path), "unlock"])
-    assert done.returncode == -signal.SIGKILL
+    assert killed_appender(path, "unlock", tiny_result) == -signal.SIGKILL
     assert set(pi.Archive(path).runs()) == {"w/v", "w/killed"}
     np.testing.assert_array_equal(
         pi.Archive(path).results("killed").exit_speed, tiny_result.exit_speed
@@ -140,28 +230,21 @@ def test_an_appender_killed_holding_the_lock_after_its_run_is_in_keeps_it(tmp_pa
     assert len(pi.Archive(path).runs()) == 3 and debris(tmp_path) == []
 
 
-RACER = """
-import sys
-import numpy as np
-import plateimpact as pi
-study = pi.Study.grid("w", ["2024-T3/3.18"], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
-result = study.run()["v"]
-for k in range(3):  # waiting as long as it takes: no clock decides where a run goes
-    archive = pi.Archive(sys.argv[1], wait=float("inf"))
-    archive.append_run(study, pi.Variant(f"p{sys.argv[2]}r{k}"), result, {"n": k})
-"""
-
-
 @pytest.mark.filterwarnings("ignore::plateimpact.base.errors.ArchiveWaitWarning")
-def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
+def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result, make_archive):
     path = tmp_path / "a.h5"
     link = tmp_path / "link.h5"
     make_archive(path)
     link.symlink_to(path)  # half the threads write through a link: one lock, one file
     study = tiny_study()
-    processes = [
-        subprocess.Popen([sys.executable, "-c", RACER, str(path), str(p)]) for p in range(4)
-    ]
+
+    def racer(p: int) -> None:
+        for k in range(3):  # waiting as long as it takes: no clock decides where a run goes
+            archive = pi.Archive(path, wait=math.inf)
+            archive.append_run(study, pi.Variant(f"p{p}r{k}"), tiny_result, {"n": k})
+
+    # forked before the threads start: a fork copies no lock another thread holds
+    processes = [Forked(lambda p=p: racer(p)) for p in range(4)]
     errors: list[BaseException] = []
 
     def appender(t: int) -> None:
@@ -177,7 +260,9 @@ def test_eight_threads_and_four_processes_lose_no_run(tmp_path, tiny_result):
         thread.start()
     for thread in threads:
         thread.join()
-    assert [p.wait() for p in processes] == [0, 0, 0, 0] and errors == []
+    ended = [p.wait() for p in processes]
+    assert [p.returncode for p in ended] == [0, 0, 0, 0], [p.stderr for p in ended]
+    assert errors == []
     runs = pi.Archive(path).runs()
     expected = {f"w/t{t}r{k}" for t in range(8) for k in range(3)}
     expected |= {f"w/p{p}r{k}" for p in range(4) for k in range(3)}
@@ -195,7 +280,7 @@ def test_a_wait_that_is_no_number_of_seconds_is_refused(tmp_path, wait):
         pi.Archive(tmp_path / "a.h5", wait=wait)
 
 
-def test_an_archive_and_an_output_keep_their_owner(tmp_path):
+def test_an_archive_and_an_output_keep_their_owner(tmp_path, make_archive):
     if os.geteuid() != 0:
         pytest.skip("giving a file to another user needs root")
     path, csv = tmp_path / "a.h5", tmp_path / "s.csv"
@@ -212,7 +297,9 @@ def test_an_archive_and_an_output_keep_their_owner(tmp_path):
     assert len(pi.Archive(path).runs()) == 2 and csv.read_text().startswith("preset,")
 
 
-def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(tmp_path, tiny_result):
+def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(
+    tmp_path, tiny_result, make_archive
+):
     path = tmp_path / "a.h5"
     make_archive(path)
     path.chmod(0o640)
@@ -228,7 +315,7 @@ def test_an_archive_keeps_its_mode_and_group_and_a_read_only_one_is_refused(tmp_
     assert path.read_bytes() == before
 
 
-def test_an_archive_of_another_format_version_is_refused(tmp_path):
+def test_an_archive_of_another_format_version_is_refused(tmp_path, make_archive):
     path = tmp_path / "a.h5"
     make_archive(path)
     with h5py.File(path, "a") as f:
@@ -242,7 +329,7 @@ def test_an_archive_of_another_format_version_is_refused(tmp_path):
     assert path.read_bytes() == before
 
 
-def test_a_group_without_its_seal_is_damaged(tmp_path):
+def test_a_group_without_its_seal_is_damaged(tmp_path, make_archive):
     path = tmp_path / "a.h5"
     make_archive(path)
     with h5py.File(path, "a") as f:
@@ -275,7 +362,7 @@ def test_show_of_what_is_not_an_archive_file_is_one_line(argument, words, tmp_pa
     assert_one_line(code, err, words)
 
 
-def test_a_full_disk_during_an_append_keeps_the_archive_and_is_one_line(tmp_path):
+def test_a_full_disk_during_an_append_keeps_the_archive_and_is_one_line(tmp_path, make_archive):
     with mounted(tmp_path, "size=256k") as disk:
         path = disk / "a.h5"
         before = make_archive(path)

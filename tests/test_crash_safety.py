@@ -2,55 +2,25 @@
 opens, with every finished run intact and the interrupted one absent, and
 ``study.run(resume=True)`` completes it.
 
-The kills are deterministic, never timed: the writer kills itself on entering a chunk of
-scenes (before, during and between runs) or at a named stage of a run's append
-(``storage.append.fault_point``), so what a test sees never depends on how fast or busy
-the machine is. Four kill points in CI; every one with HYPOTHESIS_PROFILE=stress."""
+The kills are deterministic, never timed: the writer, a child forked from the test's
+process, kills itself on entering a chunk of scenes (before, during and between runs) or
+at a named stage of a run's append (``storage.append.fault_point``), so what a test sees
+never depends on how fast or busy the machine is. Four kill points in CI; every one with
+HYPOTHESIS_PROFILE=stress."""
 
 from __future__ import annotations
 
 import os
 import signal
-import subprocess
-import sys
-import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
-from test_archive_writers import debris
+from test_archive_writers import debris, forked
 
 import plateimpact as pi
-
-SCRIPT = """
-import os, signal, sys
 import plateimpact.run.simulation
 from plateimpact.storage import append
-sys.path.insert(0, {tests!r})
-from test_crash_safety import CHUNK, study
-
-kind, where = sys.argv[2], sys.argv[3:]
-chunks, appends = [0], [0]
-run_chunk = plateimpact.run.simulation.run_chunk
-
-def die():
-    os.kill(os.getpid(), signal.SIGKILL)
-
-def counted_chunk(*args, **kwargs):
-    chunks[0] += 1
-    if kind == "chunk" and chunks[0] == int(where[0]):
-        die()
-    return run_chunk(*args, **kwargs)
-
-def fault_point(stage):
-    if stage == "copy":
-        appends[0] += 1
-    if kind == "append" and appends[0] == int(where[0]) and stage == where[1]:
-        die()
-
-plateimpact.run.simulation.run_chunk = counted_chunk
-append.fault_point = fault_point
-study().run(archive=sys.argv[1], chunk_size=CHUNK)
-"""
 
 #: Scenes per chunk: each run is two chunks.
 CHUNK = 20
@@ -79,6 +49,36 @@ CI_KILLS = [("chunk", "2"), ("append", "1", "flush"), ("chunk", "5"), ("append",
 KILLS = EVERY_KILL if os.environ.get("HYPOTHESIS_PROFILE") == "stress" else CI_KILLS
 
 
+def killed_writer(path: Path, kill: tuple[str, ...]) -> int:
+    """The returncode of a writer (forked from this process) that runs :func:`study` into
+    ``path`` and SIGKILLs itself at ``kill``."""
+    kind, where = kill[0], kill[1:]
+    chunks, appends = [0], [0]
+    run_chunk = plateimpact.run.simulation.run_chunk
+
+    def die() -> None:
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    def counted_chunk(*args, **kwargs):
+        chunks[0] += 1
+        if kind == "chunk" and chunks[0] == int(where[0]):
+            die()
+        return run_chunk(*args, **kwargs)
+
+    def fault_point(stage: str) -> None:
+        if stage == "copy":
+            appends[0] += 1
+        if kind == "append" and appends[0] == int(where[0]) and stage == where[1]:
+            die()
+
+    def write() -> None:  # in the child: this process's modules are untouched
+        plateimpact.run.simulation.run_chunk = counted_chunk
+        append.fault_point = fault_point
+        study().run(archive=path, chunk_size=CHUNK)
+
+    return forked(write).returncode
+
+
 def finished_before(kill: tuple[str, ...]) -> int:
     """The runs a writer killed at ``kill`` has finished (its append is in)."""
     if kill[0] == "chunk":
@@ -93,11 +93,8 @@ def expected() -> pi.StudyResults:
 
 @pytest.mark.parametrize("kill", KILLS, ids="-".join)
 def test_a_kill_anywhere_never_loses_a_finished_run_and_resume_completes(tmp_path, expected, kill):
-    script = tmp_path / "writer.py"
-    script.write_text(textwrap.dedent(SCRIPT.format(tests=os.path.dirname(__file__))))
     path = tmp_path / "a.h5"
-    child = subprocess.run([sys.executable, str(script), str(path), *kill])
-    assert child.returncode == -signal.SIGKILL
+    assert killed_writer(path, kill) == -signal.SIGKILL
     finished = finished_before(kill)
     if finished:
         archive = pi.Archive(path)

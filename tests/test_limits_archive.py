@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import subprocess
 import sys
 
 import attrs
@@ -15,12 +14,13 @@ import numpy as np
 import pytest
 from old_records import to_old_layout
 from test_archive import flip_bytes
-from test_archive_writers import STAGES, debris
+from test_archive_writers import STAGES, archive_maker, debris, forked
 from test_limits import ESTAR, E, P
 from test_output_files import assert_one_line, run_cli
 
 import plateimpact as pi
 from plateimpact import limits, presets
+from plateimpact.cli import main
 from plateimpact.limits.archived import attributes_of
 from plateimpact.storage import append as appending
 from plateimpact.storage.lock import locked
@@ -67,6 +67,12 @@ def tiny_study() -> pi.Study:
     return pi.Study.grid("w", [PLATE], [0, 45], np.array([300.0, 900.0]), pi.Variant("v"))
 
 
+@pytest.fixture(scope="module")
+def make_archive(tmp_path_factory):
+    """``make_archive(path)``: the tiny study's archive, written once, copied to ``path``."""
+    return archive_maker(tmp_path_factory.mktemp("start"))
+
+
 def assert_same_limits(back: limits.Limits, found: limits.Limits) -> None:
     assert (back.axis, back.tolerance, back.resolution) == (
         found.axis, found.tolerance, found.resolution,
@@ -102,9 +108,11 @@ def test_limits_and_maps_read_back_as_written(tmp_path, plugging, by_obliquity, 
     assert len(back.boundary_curves()) == len(outcome_map.boundary_curves())
 
 
-def test_a_name_taken_gets_the_next_number_and_studies_are_untouched(tmp_path, plugging):
+def test_a_name_taken_gets_the_next_number_and_studies_are_untouched(
+    tmp_path, plugging, make_archive
+):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     names = [limits.archive_limits(path, "plugging", plugging) for _ in range(3)]
     assert names == ["plugging", "plugging.2", "plugging.3"]
     assert limits.stored_limits(path) == names == pi.Archive(path).limits_names()
@@ -129,9 +137,9 @@ def test_names_that_would_not_survive_or_would_be_misread_are_refused(tmp_path, 
     assert not path.exists()
 
 
-def test_an_older_archive_with_a_study_named_limits_stays_a_study(tmp_path, plugging):
+def test_an_older_archive_with_a_study_named_limits_stays_a_study(tmp_path, plugging, make_archive):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     with h5py.File(path, "a") as f:
         f.move("w", "limits")  # as an older plateimpact let a study be named
     archive = pi.Archive(path)
@@ -196,7 +204,7 @@ def test_a_dataset_attribute_that_crashes_hdf5_is_never_read(tmp_path, plugging)
     exist) makes libhdf5 crash when the attribute is read. Reading a record reads no
     dataset attributes (they are for readers without plateimpact); the data,
     checksummed, reads back whole. A netCDF record's object headers carry checksums:
-    there the same flip is damage, said in one line. Run in subprocesses, so that a
+    there the same flip is damage, said in one line. Run in forked children, so that a
     crash fails the test instead of ending pytest."""
     path = tmp_path / "a.h5"
     limits.archive_limits(path, "plugging", plugging)
@@ -206,34 +214,32 @@ def test_a_dataset_attribute_that_crashes_hdf5_is_never_read(tmp_path, plugging)
     assert data.count(CRASHES_HDF5) > 10  # every dataset's long_name, as h5py lays it out
     damaged = data.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05")
     record_file(path, "plugging").write_bytes(damaged)
-    plain = (
-        "import h5py, sys; "
-        "h5py.File(sys.argv[1])['limits/plugging/sphere/radius'].attrs['long_name']"
-    )
-    assert subprocess.run([sys.executable, "-c", plain, str(path)]).returncode != 0
-    ours = (
-        "import sys; from plateimpact import limits; from plateimpact.cli import main; "
-        "print(limits.read_limits(sys.argv[1], 'plugging').lines[1].ballistic_limit); "
-        "sys.exit(main(['show', sys.argv[1]]))"
-    )
-    done = subprocess.run([sys.executable, "-c", ours, str(path)], capture_output=True, text=True)
+    plain = forked(lambda: h5py.File(path)["limits/plugging/sphere/radius"].attrs["long_name"])
+    assert plain.returncode != 0
+
+    def read_and_show() -> None:
+        print(limits.read_limits(path, "plugging").lines[1].ballistic_limit)
+        sys.exit(main(["show", str(path)]))
+
+    done = forked(read_and_show)
     assert done.returncode == 0, done.stderr
     assert float(done.stdout.splitlines()[0]) == plugging.lines[1].ballistic_limit
     assert "limits/plugging: limits along impact speed" in done.stdout
     assert netcdf.count(CRASHES_HDF5) > 10
     damaged = netcdf.replace(CRASHES_HDF5, CRASHES_HDF5[:-1] + b"\x05")
     record_file(path, "plugging").write_bytes(damaged)
-    shown = [sys.executable, "-m", "plateimpact.cli", "show", str(path)]
-    done = subprocess.run(shown, capture_output=True, text=True)
+    done = forked(lambda: sys.exit(main(["show", str(path)])))  # as the command ends
     assert_one_line(done.returncode, done.stderr, "limits/plugging", "damaged")
 
 
 # -- reviewed without plateimpact ------------------------------------------------------------
 
 
-def test_the_file_reads_in_plain_h5py_with_units_everywhere(tmp_path, plugging, outcome_map):
+def test_the_file_reads_in_plain_h5py_with_units_everywhere(
+    tmp_path, plugging, outcome_map, make_archive
+):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     limits.archive_limits(path, "plugging", plugging)
     limits.archive_limits(path, "map", outcome_map)
     datasets: list[h5py.Dataset] = []
@@ -278,10 +284,10 @@ def test_the_file_reads_in_plain_h5py_with_units_everywhere(tmp_path, plugging, 
 
 @pytest.mark.parametrize("stage", STAGES)
 def test_a_failed_append_of_limits_leaves_the_archive_as_it_was(
-    tmp_path, stage, monkeypatch, plugging
+    tmp_path, stage, monkeypatch, plugging, make_archive
 ):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     limits.archive_limits(path, "plugging", plugging)
     before = path.read_bytes()
 
@@ -314,9 +320,11 @@ def test_a_failure_letting_go_of_the_lock_keeps_the_limits_and_says_so(
 
 
 @pytest.mark.filterwarnings("ignore::plateimpact.base.errors.ArchiveWaitWarning")
-def test_limits_that_cannot_wait_for_another_writer_are_saved_aside(tmp_path, plugging):
+def test_limits_that_cannot_wait_for_another_writer_are_saved_aside(
+    tmp_path, plugging, make_archive
+):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     before = path.read_bytes()
     archive = pi.Archive(path, wait=0.0)
     with locked(archive.path, archive.real, archive.lock_path, 1.0):
@@ -369,10 +377,10 @@ def numbers_after(text: str, words: str) -> list[float]:
 
 
 def test_show_lists_limits_and_maps_and_leaves_the_runs_as_they_were(
-    tmp_path, plugging, by_obliquity, outcome_map
+    tmp_path, plugging, by_obliquity, outcome_map, make_archive
 ):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     code, runs_only, _ = run_cli(["show", str(path)])
     assert code == 0
     limits.archive_limits(path, "plugging", plugging)
@@ -457,9 +465,9 @@ def test_compare_reports_lines_in_one_only(tmp_path, plugging, outcome_map):
     assert "obliquity 30 deg: the line is only in map" in text
 
 
-def test_bad_show_and_compare_use_is_one_line(tmp_path, plugging, by_obliquity):
+def test_bad_show_and_compare_use_is_one_line(tmp_path, plugging, by_obliquity, make_archive):
     path = tmp_path / "a.h5"
-    tiny_study().run(archive=path)
+    make_archive(path)
     limits.archive_limits(path, "plugging", plugging)
     limits.archive_limits(path, "critical", by_obliquity)
     png = str(tmp_path / "c.png")
