@@ -277,6 +277,8 @@ def test_crater_writes_csv_and_png(tmp_path, capsys):
                 str(table),
                 "--png",
                 str(picture),
+                "--dpi",
+                "50",
             ]
         )
         == 0
