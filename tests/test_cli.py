@@ -52,11 +52,11 @@ CASES = [
         {"failure": "hinge", "failure_settings": {"finger_area_scale": 0.5}},
     ),
     (
-        ["--integrator", "segment", "--step", "2e-3", "--set", "model.rest_speed_fraction=0.02"],
+        ["--integrator", "segment", "--step", "2e-2", "--set", "model.rest_speed_fraction=0.02"],
         {},
         {
             "integrator": "segment",
-            "integrator_settings": {"step": 2e-3},
+            "integrator_settings": {"step": 2e-2},
             "rest_speed_fraction": 0.02,
         },
     ),
@@ -125,7 +125,7 @@ def test_sweep_writes_one_row_per_scene(tmp_path, capsys):
         "--integrator",
         "segment",
         "--step",
-        "4e-3",
+        "4e-2",
     ]
     assert main(args) == 0
     rows = list(csv.reader(io.StringIO(capsys.readouterr().out)))
@@ -277,6 +277,8 @@ def test_crater_writes_csv_and_png(tmp_path, capsys):
                 str(table),
                 "--png",
                 str(picture),
+                "--dpi",
+                "50",
             ]
         )
         == 0

@@ -23,8 +23,10 @@ def grid(plate, obliquities, speeds=SPEEDS):
 
 
 #: The segment step of the tests whose claims hold at any step (identities to the last
-#: bit, the finger making a difference): the coarsest the integrator allows but one.
-ANY_STEP = 1e-2
+#: bit, the finger making a difference, exact zeros at normal incidence, the finger
+#: angle's start rule and its peeling): half the coarsest the integrator allows, where
+#: the grids below still reach every outcome and fail the same plates as at 1e-2.
+ANY_STEP = 5e-2
 
 
 def run(batch, failure, integrator="segment", step=2e-3, **settings):
@@ -83,7 +85,11 @@ def test_hinge_finger_at_normal_incidence_has_no_lift(integrator):
     view = batch.failure
     _, incidence = hinge.finger(np.zeros(1), 2.0 * view.failure_angle, view)
     assert incidence[0] == 0.0
-    simulation = pi.Simulation.from_names(failure="hinge", integrator=integrator)
+    simulation = pi.Simulation.from_names(
+        failure="hinge",
+        integrator=integrator,
+        integrator_settings={"step": ANY_STEP} if integrator == "segment" else {},
+    )
     result = simulation.run(pi.Scene(sphere, plate, 403.0, 0.0), record_trajectory=True)
     assert result.plate_failed and result.exit_obliquity == 0.0
     assert np.all(result.trajectory.lateral == 0.0)
@@ -154,8 +160,12 @@ class TestHingeFinger:
     """The finger angle β follows eqs 18 and the start rule; F″ acts per eqs 16–20."""
 
     def trajectory(self, obliquity_deg, speed=700.0):
+        # The segment method moves β at its start rate, so a β that only falls stays
+        # monotone at any step (dopri5's combination of stage rates raises it by 4e-9 rad
+        # at the kink where it reaches zero); the finger is gone at 82% of the contact
+        # time at steps 1e-3, 1e-2 and 5e-2 alike.
         simulation = pi.Simulation.from_names(
-            failure="hinge", integrator="segment", integrator_settings={"step": 1e-3}
+            failure="hinge", integrator="segment", integrator_settings={"step": ANY_STEP}
         )
         scene = pi.Scene(presets.DEFAULT_SPHERE, STEEL, speed, np.radians(obliquity_deg))
         result = simulation.run(scene, record_trajectory=True)

@@ -79,12 +79,18 @@ def scenes():
     return [pi.Scene(SPHERE, presets.plate(p), v, o * deg) for p, v, o in SCENES]
 
 
-@pytest.fixture(scope="module")
-def reference(scenes):
+def accurate(scenes, failure=None):
+    """DOP853 at rtol 1e-12: the reference of the accuracy targets."""
     simulation = pi.Simulation.from_names(
-        integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
+        failure=failure, integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
     )
     return simulation.run_batch(scenes)
+
+
+@pytest.fixture(scope="module")
+def reference(scenes):
+    """The default model's reference (its failure model: the registry's default)."""
+    return accurate(scenes)
 
 
 def test_default_integrator_meets_its_accuracy_target(scenes, reference):
@@ -102,14 +108,13 @@ def test_default_integrator_meets_its_accuracy_target(scenes, reference):
 
 
 @pytest.mark.parametrize("failure", ["plugging", "hinge"])
-def test_stepping_across_or_onto_branch_surfaces_meets_the_targets(failure, scenes):
+def test_stepping_across_or_onto_branch_surfaces_meets_the_targets(failure, scenes, reference):
     """Whether dopri5 steps onto the surfaces where the force stops being smooth (the
     default) or across them, it reaches the reference's outcomes, and on them the
     default's accuracy targets (what landing saves in steps and error is a benchmark:
     benchmarks/branch_landing.py)."""
-    reference = pi.Simulation.from_names(
-        failure=failure, integrator="solve_ivp", integrator_settings={"rtol": 1e-12}
-    ).run_batch(scenes)
+    if failure != pi.default_registry().default("failure"):  # else the module's, run once
+        reference = accurate(scenes, failure)
     speed = np.array([s.impact_speed for s in scenes])
     flying = reference.outcome != pi.Outcome.EMBEDMENT
     for landing, rtol in ((True, 1e-8), (False, 1e-10)):
@@ -122,13 +127,24 @@ def test_stepping_across_or_onto_branch_surfaces_meets_the_targets(failure, scen
         assert np.degrees(np.max(turn_error)) <= 1e-4
 
 
+#: Settings of the fixed-step integrators where a claim holds at any step (events located
+#: on the dense output, exact zeros): steps 10 and 5 times their defaults, at which the
+#: scenes above still end in the reference's outcomes (the segment method's first
+#: differs at 5e-2: the embedment after failure perforates).
+COARSE = {"segment": {"step": 1e-2}, "rk4": {"step": 5e-2}}
+
+
 @pytest.mark.parametrize("integrator", EVERY_INTEGRATOR)
 def test_events_are_located_on_their_surfaces(integrator, scenes, reference, docs_registry):
     # Failure starts at P = P*, rest is reached at V = f·Vs, a ricochet leaves where the
     # contact-lost margin is zero: events are located, not stepped over, whatever the
-    # integrator (the driver locates them on its dense output). And the outcomes are the
-    # reference's.
-    simulation = pi.Simulation.from_names(integrator=integrator, registry=docs_registry)
+    # integrator (the driver locates them on its dense output) and its step. And the
+    # outcomes are the reference's.
+    simulation = pi.Simulation.from_names(
+        integrator=integrator,
+        registry=docs_registry,
+        integrator_settings=COARSE.get(integrator, {}),
+    )
     result = simulation.run_batch(scenes, record_trajectory=True)
     np.testing.assert_array_equal(result.outcome, reference.outcome)
     pstar = np.array([s.plate.critical_penetration for s in scenes])

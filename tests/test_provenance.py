@@ -241,7 +241,7 @@ def test_run_json_records_every_input_as_typed(capsys):
 
 @pytest.mark.parametrize(
     "options",
-    [CUSTOM, ["--failure", "variable-pstar", "--integrator", "segment", "--step", "2e-3"]],
+    [CUSTOM, ["--failure", "variable-pstar", "--integrator", "segment", "--step", "2e-2"]],
     ids=["custom", "variable-pstar"],
 )
 def test_run_json_reruns_bit_for_bit_from_itself_alone(tmp_path, capsys, options):
