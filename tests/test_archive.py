@@ -350,9 +350,12 @@ def test_a_local_dask_cluster_gives_the_in_process_results(tmp_path):
     distributed = pytest.importorskip("distributed")
     study = small_study()
     local = study.run()
+    # One worker process: every chunk goes to it and back pickled, as to any worker; the
+    # results come back in the order the chunks were sent (run.simulation.run_in_chunks),
+    # so a second worker would change only which process ran a chunk, and when
     with (
         distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
         ) as cluster,
         distributed.Client(cluster) as client,
     ):
