@@ -285,10 +285,8 @@ def test_plot_and_show_from_an_archive(tmp_path, capsys):
     path = tmp_path / "a.h5"
     small_study().run(archive=path)
     png = tmp_path / "p.png"
-    assert (
-        cli(["plot", str(path), "--run", "plugging", "--run", "large-pstar", "--out", str(png)])
-        == 0
-    )
+    runs = ["--run", "plugging", "--run", "large-pstar"]
+    assert cli(["plot", str(path), *runs, "--out", str(png), "--dpi", "50"]) == 0  # a PNG
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert cli(["show", str(path)]) == 0
     out = capsys.readouterr().out
@@ -331,6 +329,7 @@ def test_trajectory_and_crater_plots_from_an_archive(tmp_path, capsys):
     for kind in ("crater", "trajectory"):
         png = tmp_path / f"{kind}.png"
         args = ["plot", str(path), "--run", "default", "--kind", kind, "--out", str(png)]
+        args += ["--dpi", "50"]  # a PNG, whatever its pixels
         assert cli([*args, "--speed", "300", "--speed", "900"]) == 0
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert cli(["show", str(path)]) == 0
