@@ -25,6 +25,15 @@ def small_study(name="t318", trajectory_variant=False):
     return pi.Study.grid(name, ["2024-T3/3.18", "SAE1010/1.47"], [0, 45, 60], SPEEDS, variants)
 
 
+@pytest.fixture(scope="module")
+def small_archive(tmp_path_factory) -> pathlib.Path:
+    """:func:`small_study` run into an archive once, for the tests that only read it (a
+    test that changes it changes a copy)."""
+    path = tmp_path_factory.mktemp("small") / "a.h5"
+    small_study().run(archive=path)
+    return path
+
+
 def assert_same(a: pi.BatchResult, b: pi.BatchResult) -> None:
     for name, column in a.columns.items():
         np.testing.assert_array_equal(b.columns[name], column, err_msg=name)
@@ -243,9 +252,8 @@ def flip_bytes(path, dataset):
         handle.write(bytes([byte[0] ^ 0xFF]))
 
 
-def test_bad_archives_give_one_line_errors(tmp_path, capsys):
-    path = tmp_path / "a.h5"
-    small_study().run(archive=path)
+def test_bad_archives_give_one_line_errors(small_archive, tmp_path, capsys):
+    path = shutil.copytree(small_archive.parent, tmp_path / "copy") / "a.h5"
     flip_bytes(pi.Archive(path).data_file("plugging"), "exit_speed")
     with pytest.raises(pi.ArchiveError, match="damaged"):
         pi.Archive(path).results("plugging")
@@ -265,9 +273,9 @@ def test_bad_archives_give_one_line_errors(tmp_path, capsys):
         small_study().run(archive=tmp_path / "missing" / "a.h5")
 
 
-def test_compare_reports_the_large_pstar_outcome_changes(tmp_path, capsys):
-    path = tmp_path / "a.h5"
-    results = small_study().run(archive=path)
+def test_compare_reports_the_large_pstar_outcome_changes(small_archive, capsys):
+    path = small_archive
+    results = pi.StudyResults.from_archive(path)
     comparison = results.compare("plugging", "large-pstar")
     plugging, intact = results["plugging"].outcome, results["large-pstar"].outcome
     failed = results["plugging"].plate_failed != results["large-pstar"].plate_failed
@@ -281,9 +289,8 @@ def test_compare_reports_the_large_pstar_outcome_changes(tmp_path, capsys):
     assert "perforation -> embedment" in out  # in ranges: tests/test_compare.py
 
 
-def test_plot_and_show_from_an_archive(tmp_path, capsys):
-    path = tmp_path / "a.h5"
-    small_study().run(archive=path)
+def test_plot_and_show_from_an_archive(small_archive, tmp_path, capsys):
+    path = small_archive
     png = tmp_path / "p.png"
     runs = ["--run", "plugging", "--run", "large-pstar"]
     assert cli(["plot", str(path), *runs, "--out", str(png), "--dpi", "50"]) == 0  # a PNG
@@ -322,7 +329,7 @@ def test_archived_craters_are_the_sections_of_the_archived_paths(tmp_path):
     np.testing.assert_array_equal(part.crater_of(1).depth, result.crater_of(0).depth)
 
 
-def test_trajectory_and_crater_plots_from_an_archive(tmp_path, capsys):
+def test_trajectory_and_crater_plots_from_an_archive(small_archive, tmp_path, capsys):
     path = tmp_path / "a.h5"
     study = pi.Study.grid("c", ["2024-T3/3.18"], [0, 60], SPEEDS, pi.Variant("default"))
     study.run(archive=path, craters=True)
@@ -334,8 +341,7 @@ def test_trajectory_and_crater_plots_from_an_archive(tmp_path, capsys):
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert cli(["show", str(path)]) == 0
     assert "with trajectories and craters" in capsys.readouterr().out
-    bare = tmp_path / "bare.h5"
-    small_study().run(archive=bare)
+    bare = small_archive
     out = str(tmp_path / "x.png")
     assert cli(["plot", str(bare), "--run", "plugging", "--kind", "crater", "--out", out]) == 2
     err = capsys.readouterr().err.strip()
