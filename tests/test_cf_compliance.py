@@ -150,8 +150,10 @@ def test_every_file_passes_every_cf_check(files, records, tmp_path):
         assert failed_checks(path, tmp_path / "report.json") == [], path.name
 
 
+@functools.cache
 def opened(path: Path) -> xarray.Dataset:
-    """The file as xarray opens it, any warning an error."""
+    """The file as xarray opens it, any warning an error; read once per file (the tests
+    only read what it returns)."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with xarray.open_dataset(path, engine="h5netcdf") as data:
