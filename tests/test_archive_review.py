@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
 import h5py
 import numpy as np
@@ -144,6 +145,13 @@ def test_reproduce_twice_on_the_command_line(tmp_path, monkeypatch):
     monkeypatch.setattr(reproduce.fig35_37_craters_60deg, "study", lambda: crater)
     monkeypatch.setattr(reproduce, "MAP_SAMPLES", 3)
     monkeypatch.setattr(reproduce, "MAP_OBLIQUITIES", np.radians([0.0, 60.0]))
+    # the map of one plate, not five (each plate's map is stored, kept or tagged alike)
+    presets = pi.presets
+    one_plate = {"2024-T3/3.18": presets.plate("2024-T3/3.18")}
+    stand_in = SimpleNamespace(
+        PLATES=one_plate, plate=presets.plate, DEFAULT_SPHERE=presets.DEFAULT_SPHERE
+    )
+    monkeypatch.setattr(reproduce, "presets", stand_in)
     monkeypatch.setattr(reproduce, "experiment", lambda *args: [])  # its own test runs it
     # What is checked is the archive's: the figures are not drawn (test_archive's
     # reproduce test draws every one), only named
@@ -161,6 +169,8 @@ def test_reproduce_twice_on_the_command_line(tmp_path, monkeypatch):
     assert pi.Archive(out / "report.h5").runs() == ["c/d", "f/v"]
     assert run_cli(["reproduce", "--out", str(out), "--as", "b"])[0] == 0
     assert sorted(pi.Archive(out / "report.h5").runs()) == ["c/d", "c/d@b", "f/v", "f/v@b"]
+    maps = ["map_2024-T3_3.18", "map_2024-T3_3.18@b"]  # the maps tagged too
+    assert sorted(pi.Archive(out / "report.h5").limits_names()) == maps
     assert run_cli(["reproduce", "--out", str(out), "--overwrite"])[0] == 0
     assert len(pi.Archive(out / "report.h5").runs()) == 4
     assert drawn == 4 * figures  # each run that ran draws them again
