@@ -13,7 +13,7 @@ import copy
 import functools
 import json
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -97,13 +97,16 @@ PER_FILE_HELPERS = (
 @contextlib.contextmanager
 def helpers_once_per_file() -> Iterator[None]:
     """While open, each of :data:`PER_FILE_HELPERS` computed once per file (or group) it
-    is given, each caller handed its own copy of the answer; a helper the installed
-    checker lacks is left alone (the checks are the same, only slower)."""
+    is given, each caller handed its own copy of the answer; a name the installed checker
+    lacks is skipped, a call with more arguments than the file passed through (the
+    checks are the same, at worst slower)."""
     answers: dict[tuple[str, int], tuple[object, object]] = {}
 
-    def once(name, helper):
+    def once(name: str, helper: Callable[..., object]) -> Callable[..., object]:
         @functools.wraps(helper)
-        def cached(nc):
+        def cached(nc: object, *more: object) -> object:
+            if more:
+                return helper(nc, *more)
             if (name, id(nc)) not in answers:  # the file kept: its id not reused meanwhile
                 answers[name, id(nc)] = (nc, helper(nc))
             return copy.copy(answers[name, id(nc)][1])
