@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import pathlib
 import shutil
 import signal
@@ -11,8 +12,10 @@ import sys
 import h5py
 import numpy as np
 import pytest
+from test_archive_writers import forked
 
 import plateimpact as pi
+import plateimpact.run.simulation
 from plateimpact.cli import main as cli
 from plateimpact.limits import stored_limits
 from plateimpact.model.crater import crater_section
@@ -133,37 +136,30 @@ def test_runs_append_without_touching_earlier_ones(tmp_path):
         other.run(archive=path)
 
 
-KILL_SCRIPT = """
-import os, signal, sys
-import numpy as np
-import plateimpact as pi
-import plateimpact.run.simulation
-run_chunk, calls = plateimpact.run.simulation.run_chunk, [0]
-def chunk(*args, **kwargs):
-    calls[0] += 1
-    if calls[0] == 5:  # the second run's second chunk of three: killed there, not timed
-        os.kill(os.getpid(), signal.SIGKILL)
-    return run_chunk(*args, **kwargs)
-plateimpact.run.simulation.run_chunk = chunk
-study = pi.Study.grid(
-    "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20),
-    [pi.Variant("fast"),
-     pi.Variant("second", integrator="segment", integrator_settings={"step": 1e-2})],
-)
-study.run(archive=sys.argv[1], chunk_size=20)
-"""
+def kill_study(variants: list[pi.Variant]) -> pi.Study:
+    return pi.Study.grid("kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20),
+                         variants)  # fmt: skip
 
 
 def test_killing_the_writer_during_the_second_run_keeps_the_first(tmp_path):
     path = tmp_path / "a.h5"
-    child = subprocess.run([sys.executable, "-c", KILL_SCRIPT, str(path)])
-    assert child.returncode == -signal.SIGKILL
+    run_chunk, calls = plateimpact.run.simulation.run_chunk, [0]
+
+    def chunk(*args, **kwargs):
+        calls[0] += 1
+        if calls[0] == 5:  # the second run's second chunk of three: killed there, not timed
+            os.kill(os.getpid(), signal.SIGKILL)
+        return run_chunk(*args, **kwargs)
+
+    def write() -> None:  # in a child forked from this process: its modules untouched here
+        plateimpact.run.simulation.run_chunk = chunk
+        second = pi.Variant("second", integrator="segment", integrator_settings={"step": 1e-2})
+        kill_study([pi.Variant("fast"), second]).run(archive=path, chunk_size=20)
+
+    assert forked(write).returncode == -signal.SIGKILL
     archive = pi.Archive(path)
     assert archive.runs() == ["kill/fast"]
-    study = pi.Study.grid(
-        "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20), pi.Variant("fast")
-    )
-    assert_same(study.run()["fast"], archive.results("kill/fast"))
+    assert_same(kill_study([pi.Variant("fast")]).run()["fast"], archive.results("kill/fast"))
 
 
 def test_resume_reads_back_finished_runs_and_runs_the_rest(tmp_path):
