@@ -191,8 +191,11 @@ def undrawn_figures(monkeypatch) -> list[str]:
                          (limits_and_maps, "plot_limit_curves")]:  # fmt: skip
         monkeypatch.setattr(module, plot, lambda *args, **kwargs: None)
     drawn: list[str] = []
-    monkeypatch.setattr(saving, "save", lambda figure, path, *args, **kwargs: drawn.append(
-        Path(path).name))  # fmt: skip
+
+    def named(figure: object, path: str, *args: object, **kwargs: object) -> None:
+        drawn.append(Path(path).name)
+
+    monkeypatch.setattr(saving, "save", named)
     return drawn
 
 
