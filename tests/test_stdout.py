@@ -27,7 +27,6 @@ DRIVER = textwrap.dedent(
     """
     import gc, io, json, os, sys
     from plateimpact.cli import build_parser, main
-    build_parser()
 
     def run(cases):
         found = []
@@ -57,15 +56,20 @@ DRIVER = textwrap.dedent(
             found.append([argv, mode, os.waitstatus_to_exitcode(status), err])
         return found
 
-    light, heavy = json.loads(sys.argv[1])
+    bare, light, heavy = json.loads(sys.argv[1])
     # What is imported stays out of the collector's reach: a child then exits in a
     # tenth of the time (Python's finalisation otherwise walks, and copies, every page
     # of the parent's heap) and still flushes the standard output it sets up below.
     gc.freeze()
     # Its finalisation still touches (and so copies) each page of the heap it inherits:
-    # the cases that import nothing more run first, from the smaller heap.
-    found = run(light)
-    # what the other commands import when they need it, imported once before forking
+    # the cases that need less run first, from a smaller heap. First those that need
+    # nothing past the entry point (as `plateimpact --version` imports nothing more),
+    found = run(bare)
+    # then those that need every command's parser and the plug-ins,
+    build_parser()
+    gc.freeze()
+    found += run(light)
+    # then the rest: what the commands import when they need it, imported once here
     import plateimpact.storage.export, plateimpact.figures.saving
     import plateimpact.figures.limits_and_maps, plateimpact.figures.validation_panels
     import plateimpact.figures.v50_fits
@@ -81,14 +85,15 @@ DRIVER = textwrap.dedent(
 )
 
 
-def run_cases(
-    light: list[tuple[list[str], str]], heavy: list[tuple[list[str], str]]
-) -> list[tuple[list[str], str, int, str]]:
-    """Each case's (argv, mode, exit code, standard error); ``light``: cases whose command
-    imports nothing beyond the command line's parser (run first, from a smaller heap)."""
-    done = subprocess.run(
-        [sys.executable, "-c", DRIVER, json.dumps([light, heavy])], capture_output=True, text=True
-    )
+Cases = list[tuple[list[str], str]]
+
+
+def run_cases(bare: Cases, light: Cases, heavy: Cases) -> list[tuple[list[str], str, int, str]]:
+    """Each case's (argv, mode, exit code, standard error): ``bare``, cases that import
+    nothing past the entry point, run first; then ``light``, those that need no more than
+    the commands' parsers and the plug-ins; then ``heavy``, the rest."""
+    cases = json.dumps([bare, light, heavy])
+    done = subprocess.run([sys.executable, "-c", DRIVER, cases], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     return [tuple(case) for case in json.loads(done.stdout)]
 
@@ -149,15 +154,17 @@ def test_every_command_on_a_full_or_closed_standard_output_is_one_line(quick_rep
     # every command of the table is among them (a new command must be added here)
     assert {argv[0] for argv in every if not argv[0].startswith("-")} == {c.name for c in COMMANDS}
     cheap = [argv for argv in every if argv[0] in ("--version", "--help", "presets", "plugins")]
-    light = [(argv, mode) for argv in cheap for mode in ("buffered", "unbuffered")]
+    both = ("buffered", "unbuffered")
+    bare = [(argv, mode) for argv in cheap if argv[0].startswith("-") for mode in both]
+    light = [(argv, mode) for argv in cheap if not argv[0].startswith("-") for mode in both]
     # A closed one is refused by main before it reads its arguments (cli/__init__.py), so
     # the same for every command: one case per way in (argparse's own exits, a command,
     # the one with the most work to refuse), each importing nothing
     closed = [argv for argv in every if argv[0] in ("--version", "--help", "reproduce")]
-    light += [(argv, "closed") for argv in [*closed, every[7]]]
+    bare += [(argv, "closed") for argv in [*closed, every[7]]]
     heavy = [(argv, "buffered") for argv in every if argv not in cheap]
     heavy += [(argv, "unbuffered") for argv in (every[7], every[8])]
-    for argv, mode, code, err in run_cases(light, heavy):
+    for argv, mode, code, err in run_cases(bare, light, heavy):
         assert code == 2, (argv, mode, code, err)
         assert err.count("\n") == 1 and err.startswith("plateimpact: error: standard output"), (
             argv,
