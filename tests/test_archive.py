@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import pathlib
 import shutil
 import signal
@@ -11,8 +12,10 @@ import sys
 import h5py
 import numpy as np
 import pytest
+from test_archive_writers import forked
 
 import plateimpact as pi
+import plateimpact.run.simulation
 from plateimpact.cli import main as cli
 from plateimpact.limits import stored_limits
 from plateimpact.model.crater import crater_section
@@ -23,6 +26,15 @@ SPEEDS = np.linspace(150.0, 1200.0, 8)
 def small_study(name="t318", trajectory_variant=False):
     variants = [pi.Variant("plugging"), pi.Variant("large-pstar", failure="intact")]
     return pi.Study.grid(name, ["2024-T3/3.18", "SAE1010/1.47"], [0, 45, 60], SPEEDS, variants)
+
+
+@pytest.fixture(scope="module")
+def small_archive(tmp_path_factory) -> pathlib.Path:
+    """:func:`small_study` run into an archive once, for the tests that only read it (a
+    test that changes it changes a copy)."""
+    path = tmp_path_factory.mktemp("small") / "a.h5"
+    small_study().run(archive=path)
+    return path
 
 
 def assert_same(a: pi.BatchResult, b: pi.BatchResult) -> None:
@@ -124,37 +136,30 @@ def test_runs_append_without_touching_earlier_ones(tmp_path):
         other.run(archive=path)
 
 
-KILL_SCRIPT = """
-import os, signal, sys
-import numpy as np
-import plateimpact as pi
-import plateimpact.run.simulation
-run_chunk, calls = plateimpact.run.simulation.run_chunk, [0]
-def chunk(*args, **kwargs):
-    calls[0] += 1
-    if calls[0] == 5:  # the second run's second chunk of three: killed there, not timed
-        os.kill(os.getpid(), signal.SIGKILL)
-    return run_chunk(*args, **kwargs)
-plateimpact.run.simulation.run_chunk = chunk
-study = pi.Study.grid(
-    "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20),
-    [pi.Variant("fast"),
-     pi.Variant("second", integrator="segment", integrator_settings={"step": 1e-2})],
-)
-study.run(archive=sys.argv[1], chunk_size=20)
-"""
+def kill_study(variants: list[pi.Variant]) -> pi.Study:
+    return pi.Study.grid("kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20),
+                         variants)  # fmt: skip
 
 
 def test_killing_the_writer_during_the_second_run_keeps_the_first(tmp_path):
     path = tmp_path / "a.h5"
-    child = subprocess.run([sys.executable, "-c", KILL_SCRIPT, str(path)])
-    assert child.returncode == -signal.SIGKILL
+    run_chunk, calls = plateimpact.run.simulation.run_chunk, [0]
+
+    def chunk(*args, **kwargs):
+        calls[0] += 1
+        if calls[0] == 5:  # the second run's second chunk of three: killed there, not timed
+            os.kill(os.getpid(), signal.SIGKILL)
+        return run_chunk(*args, **kwargs)
+
+    def write() -> None:  # in a child forked from this process: its modules untouched here
+        plateimpact.run.simulation.run_chunk = chunk
+        second = pi.Variant("second", integrator="segment", integrator_settings={"step": 1e-2})
+        kill_study([pi.Variant("fast"), second]).run(archive=path, chunk_size=20)
+
+    assert forked(write).returncode == -signal.SIGKILL
     archive = pi.Archive(path)
     assert archive.runs() == ["kill/fast"]
-    study = pi.Study.grid(
-        "kill", ["2024-T3/3.18"], [0, 45, 60], np.linspace(150.0, 1200.0, 20), pi.Variant("fast")
-    )
-    assert_same(study.run()["fast"], archive.results("kill/fast"))
+    assert_same(kill_study([pi.Variant("fast")]).run()["fast"], archive.results("kill/fast"))
 
 
 def test_resume_reads_back_finished_runs_and_runs_the_rest(tmp_path):
@@ -243,9 +248,8 @@ def flip_bytes(path, dataset):
         handle.write(bytes([byte[0] ^ 0xFF]))
 
 
-def test_bad_archives_give_one_line_errors(tmp_path, capsys):
-    path = tmp_path / "a.h5"
-    small_study().run(archive=path)
+def test_bad_archives_give_one_line_errors(small_archive, tmp_path, capsys):
+    path = shutil.copytree(small_archive.parent, tmp_path / "copy") / "a.h5"
     flip_bytes(pi.Archive(path).data_file("plugging"), "exit_speed")
     with pytest.raises(pi.ArchiveError, match="damaged"):
         pi.Archive(path).results("plugging")
@@ -265,9 +269,9 @@ def test_bad_archives_give_one_line_errors(tmp_path, capsys):
         small_study().run(archive=tmp_path / "missing" / "a.h5")
 
 
-def test_compare_reports_the_large_pstar_outcome_changes(tmp_path, capsys):
-    path = tmp_path / "a.h5"
-    results = small_study().run(archive=path)
+def test_compare_reports_the_large_pstar_outcome_changes(small_archive, capsys):
+    path = small_archive
+    results = pi.StudyResults.from_archive(path)
     comparison = results.compare("plugging", "large-pstar")
     plugging, intact = results["plugging"].outcome, results["large-pstar"].outcome
     failed = results["plugging"].plate_failed != results["large-pstar"].plate_failed
@@ -281,14 +285,11 @@ def test_compare_reports_the_large_pstar_outcome_changes(tmp_path, capsys):
     assert "perforation -> embedment" in out  # in ranges: tests/test_compare.py
 
 
-def test_plot_and_show_from_an_archive(tmp_path, capsys):
-    path = tmp_path / "a.h5"
-    small_study().run(archive=path)
+def test_plot_and_show_from_an_archive(small_archive, tmp_path, capsys):
+    path = small_archive
     png = tmp_path / "p.png"
-    assert (
-        cli(["plot", str(path), "--run", "plugging", "--run", "large-pstar", "--out", str(png)])
-        == 0
-    )
+    runs = ["--run", "plugging", "--run", "large-pstar"]
+    assert cli(["plot", str(path), *runs, "--out", str(png), "--dpi", "50"]) == 0  # a PNG
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert cli(["show", str(path)]) == 0
     out = capsys.readouterr().out
@@ -324,19 +325,19 @@ def test_archived_craters_are_the_sections_of_the_archived_paths(tmp_path):
     np.testing.assert_array_equal(part.crater_of(1).depth, result.crater_of(0).depth)
 
 
-def test_trajectory_and_crater_plots_from_an_archive(tmp_path, capsys):
+def test_trajectory_and_crater_plots_from_an_archive(small_archive, tmp_path, capsys):
     path = tmp_path / "a.h5"
     study = pi.Study.grid("c", ["2024-T3/3.18"], [0, 60], SPEEDS, pi.Variant("default"))
     study.run(archive=path, craters=True)
     for kind in ("crater", "trajectory"):
         png = tmp_path / f"{kind}.png"
         args = ["plot", str(path), "--run", "default", "--kind", kind, "--out", str(png)]
+        args += ["--dpi", "50"]  # a PNG, whatever its pixels
         assert cli([*args, "--speed", "300", "--speed", "900"]) == 0
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert cli(["show", str(path)]) == 0
     assert "with trajectories and craters" in capsys.readouterr().out
-    bare = tmp_path / "bare.h5"
-    small_study().run(archive=bare)
+    bare = small_archive
     out = str(tmp_path / "x.png")
     assert cli(["plot", str(bare), "--run", "plugging", "--kind", "crater", "--out", out]) == 2
     err = capsys.readouterr().err.strip()
@@ -350,9 +351,12 @@ def test_a_local_dask_cluster_gives_the_in_process_results(tmp_path):
     distributed = pytest.importorskip("distributed")
     study = small_study()
     local = study.run()
+    # One worker process: every chunk goes to it and back pickled, as to any worker; the
+    # results come back in the order the chunks were sent (run.simulation.run_in_chunks),
+    # so a second worker would change only which process ran a chunk, and when
     with (
         distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
         ) as cluster,
         distributed.Client(cluster) as client,
     ):

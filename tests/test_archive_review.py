@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
 import h5py
 import numpy as np
@@ -144,26 +145,58 @@ def test_reproduce_twice_on_the_command_line(tmp_path, monkeypatch):
     monkeypatch.setattr(reproduce.fig35_37_craters_60deg, "study", lambda: crater)
     monkeypatch.setattr(reproduce, "MAP_SAMPLES", 3)
     monkeypatch.setattr(reproduce, "MAP_OBLIQUITIES", np.radians([0.0, 60.0]))
+    # the map of one plate, not five (each plate's map is stored, kept or tagged alike)
+    presets = pi.presets
+    one_plate = {"2024-T3/3.18": presets.plate("2024-T3/3.18")}
+    stand_in = SimpleNamespace(
+        PLATES=one_plate, plate=presets.plate, DEFAULT_SPHERE=presets.DEFAULT_SPHERE
+    )
+    monkeypatch.setattr(reproduce, "presets", stand_in)
     monkeypatch.setattr(reproduce, "experiment", lambda *args: [])  # its own test runs it
+    # What is checked is the archive's: the figures are not drawn (test_archive's
+    # reproduce test draws every one), only named
+    drawn = undrawn_figures(monkeypatch)
+    figures = ["f.png", "c.png", "outcome_maps.png", "limit_curves.png"]
     out = tmp_path / "r"
-    # What is checked is the archive's: the figures are drawn coarse, as --quick's are
-    draft = ["--dpi", "50"]
-    assert run_cli(["reproduce", *draft, "--out", str(out)])[0] == 0
+    assert run_cli(["reproduce", "--out", str(out)])[0] == 0
+    assert drawn == figures
     index = (out / "report.h5").read_bytes()
-    code, _, err = run_cli(["reproduce", *draft, "--out", str(out)])
+    code, _, err = run_cli(["reproduce", "--out", str(out)])
     assert_one_line(code, err, "already has run", "--resume", "--overwrite", "--as TAG")
     assert (out / "report.h5").read_bytes() == index  # refused before anything ran
-    assert run_cli(["reproduce", *draft, "--out", str(out), "--resume"])[0] == 0
+    assert drawn == figures
+    assert run_cli(["reproduce", "--out", str(out), "--resume"])[0] == 0
     assert pi.Archive(out / "report.h5").runs() == ["c/d", "f/v"]
-    assert run_cli(["reproduce", *draft, "--out", str(out), "--as", "b"])[0] == 0
+    assert run_cli(["reproduce", "--out", str(out), "--as", "b"])[0] == 0
     assert sorted(pi.Archive(out / "report.h5").runs()) == ["c/d", "c/d@b", "f/v", "f/v@b"]
-    assert run_cli(["reproduce", *draft, "--out", str(out), "--overwrite"])[0] == 0
+    maps = ["map_2024-T3_3.18", "map_2024-T3_3.18@b"]  # the maps tagged too
+    assert sorted(pi.Archive(out / "report.h5").limits_names()) == maps
+    assert run_cli(["reproduce", "--out", str(out), "--overwrite"])[0] == 0
     assert len(pi.Archive(out / "report.h5").runs()) == 4
-    code, _, err = run_cli(["reproduce", *draft, "--out", str(out), "--resume", "--overwrite"])
+    assert drawn == 4 * figures  # each run that ran draws them again
+    code, _, err = run_cli(["reproduce", "--out", str(out), "--resume", "--overwrite"])
     assert code == 2 and "not allowed with" in err
     for tag in ("", "a/b", "two words"):
-        code, _, err = run_cli(["reproduce", *draft, "--out", str(out), "--as", tag])
+        code, _, err = run_cli(["reproduce", "--out", str(out), "--as", tag])
         assert_one_line(code, err, "--as", "printable tag")
+
+
+def undrawn_figures(monkeypatch) -> list[str]:
+    """The names of the figures saved from now on, in order, none of them drawn or written
+    (the report's figure families, crater sections and maps)."""
+    from plateimpact.figures import exit_curves, limits_and_maps, saving, study_paths
+
+    for module, plot in [(exit_curves, "plot_study"), (study_paths, "plot_study_paths"),
+                         (limits_and_maps, "plot_outcome_map"),
+                         (limits_and_maps, "plot_limit_curves")]:  # fmt: skip
+        monkeypatch.setattr(module, plot, lambda *args, **kwargs: None)
+    drawn: list[str] = []
+
+    def named(figure: object, path: str, *args: object, **kwargs: object) -> None:
+        drawn.append(Path(path).name)
+
+    monkeypatch.setattr(saving, "save", named)
+    return drawn
 
 
 def assert_recomputed(rerun: pi.BatchResult, stored: pi.BatchResult, scenes: pi.SceneBatch):

@@ -8,13 +8,18 @@ record exported; and each layout of file in the archive ``plateimpact reproduce`
 
 from __future__ import annotations
 
+import contextlib
+import copy
+import functools
 import json
 import warnings
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray
+from compliance_checker.cf import util as checker_util
 from compliance_checker.runner import CheckSuite, ComplianceChecker
 from test_output_files import run_cli
 
@@ -76,13 +81,62 @@ def records(tmp_path_factory) -> list[Path]:
     return [*stored, exported]
 
 
+#: The checker's helpers that list a file's variables of one kind (its time, axis,
+#: auxiliary coordinate, latitude, ... variables): each a function of the open file alone,
+#: which reads it and never writes it (as get_coordinate_variables, which the checker
+#: itself caches per file). It calls them again for each variable and check, for most of
+#: its time on these files: :func:`helpers_once_per_file` works each out once per file.
+PER_FILE_HELPERS = (
+    "get_auxiliary_coordinate_variables", "get_axis_variables", "get_time_variables",
+    "get_time_variable", "get_latitude_variables", "get_longitude_variables",
+    "get_z_variables", "get_cell_boundary_variables", "get_bounds_variables",
+    "get_platform_variables", "get_instrument_variables",
+)  # fmt: skip
+
+
+@contextlib.contextmanager
+def helpers_once_per_file() -> Iterator[None]:
+    """While open, each of :data:`PER_FILE_HELPERS` computed once per file (or group) it
+    is given, each caller handed its own copy of the answer; a name the installed checker
+    lacks is skipped, a call with more arguments than the file passed through (the
+    checks are the same, at worst slower)."""
+    answers: dict[tuple[str, int], tuple[object, object]] = {}
+
+    def once(name: str, helper: Callable[..., object]) -> Callable[..., object]:
+        @functools.wraps(helper)
+        def cached(nc: object, *more: object) -> object:
+            if more:
+                return helper(nc, *more)
+            if (name, id(nc)) not in answers:  # the file kept: its id not reused meanwhile
+                answers[name, id(nc)] = (nc, helper(nc))
+            return copy.copy(answers[name, id(nc)][1])
+
+        return cached
+
+    helpers = {name: getattr(checker_util, name) for name in PER_FILE_HELPERS
+               if callable(getattr(checker_util, name, None))}  # fmt: skip
+    try:
+        for name, helper in helpers.items():
+            setattr(checker_util, name, once(name, helper))
+        yield
+    finally:
+        for name, helper in helpers.items():
+            setattr(checker_util, name, helper)
+
+
+@functools.cache
+def load_checkers() -> None:
+    CheckSuite.load_all_available_checkers()
+
+
 def failed_checks(path: Path, report_file: Path) -> list[tuple[str, str, list[str]]]:
     """(priority, check, messages) of every CF 1.11 check the file does not pass fully."""
-    CheckSuite.load_all_available_checkers()
-    ComplianceChecker.run_checker(
-        str(path), ["cf:1.11"], 0, "normal", output_filename=str(report_file),
-        output_format="json",
-    )  # fmt: skip
+    load_checkers()
+    with helpers_once_per_file():
+        ComplianceChecker.run_checker(
+            str(path), ["cf:1.11"], 0, "normal", output_filename=str(report_file),
+            output_format="json",
+        )  # fmt: skip
     report = json.loads(report_file.read_text())["cf:1.11"]
     assert report["possible_points"] > 100  # the checks ran
     failed = []
@@ -99,8 +153,10 @@ def test_every_file_passes_every_cf_check(files, records, tmp_path):
         assert failed_checks(path, tmp_path / "report.json") == [], path.name
 
 
+@functools.cache
 def opened(path: Path) -> xarray.Dataset:
-    """The file as xarray opens it, any warning an error."""
+    """The file as xarray opens it, any warning an error; read once per file (the tests
+    only read what it returns)."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with xarray.open_dataset(path, engine="h5netcdf") as data:

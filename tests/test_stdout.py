@@ -25,57 +25,75 @@ FORMAT1 = Path(__file__).parent / "data" / "format1.h5"
 #: The child: fd 1 -> /dev/full (buffered or line by line) or closed, then main.
 DRIVER = textwrap.dedent(
     """
-    import io, json, os, sys
+    import gc, io, json, os, sys
     from plateimpact.cli import build_parser, main
-    # what the commands import when they need it, imported once before forking
+
+    def run(cases):
+        found = []
+        for argv, mode in cases:
+            read, write = os.pipe()
+            pid = os.fork()
+            if pid == 0:
+                os.close(read)
+                os.dup2(write, 2)
+                sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), write_through=True)
+                if mode == "closed":
+                    os.close(1)
+                    sys.stdout = None
+                else:
+                    full = os.open("/dev/full", os.O_WRONLY)
+                    os.dup2(full, 1)
+                    if mode == "unbuffered":  # as python -u or PYTHONUNBUFFERED=1 make it
+                        raw = open(1, "wb", buffering=0, closefd=False)
+                        sys.stdout = io.TextIOWrapper(raw, write_through=True)
+                    else:  # a file: block-buffered, flushed at exit
+                        sys.stdout = open(1, "w", closefd=False)
+                sys.exit(main(argv))  # as the console script: the interpreter exits here
+            os.close(write)
+            with os.fdopen(read, "rb") as pipe:
+                err = pipe.read().decode(errors="replace")
+            _, status = os.waitpid(pid, 0)
+            found.append([argv, mode, os.waitstatus_to_exitcode(status), err])
+        return found
+
+    bare, light, heavy = json.loads(sys.argv[1])
+    # What is imported stays out of the collector's reach: a child then exits in a
+    # tenth of the time (Python's finalisation otherwise walks, and copies, every page
+    # of the parent's heap) and still flushes the standard output it sets up below.
+    gc.freeze()
+    # Its finalisation still touches (and so copies) each page of the heap it inherits:
+    # the cases that need less run first, from a smaller heap. First those that need
+    # nothing past the entry point (as `plateimpact --version` imports nothing more),
+    found = run(bare)
+    # then those that need every command's parser and the plug-ins,
+    build_parser()
+    gc.freeze()
+    found += run(light)
+    # then the rest: what the commands import when they need it, imported once here
     import plateimpact.storage.export, plateimpact.figures.saving
     import plateimpact.figures.limits_and_maps, plateimpact.figures.validation_panels
     import plateimpact.figures.v50_fits
-    build_parser()
     # the compiled programs loaded once, here: each child inherits them rather than
     # importing numba and loading a program from the cache again
     from plateimpact.registry.plugin_registry import default_registry
     from plateimpact.solve.compiled.warming import compile_pairs, compiled_pairs
     compile_pairs(compiled_pairs(default_registry()))
-    # What is imported stays out of the collector's reach: a child then exits in a
-    # tenth of the time (Python's finalisation otherwise walks, and copies, every page
-    # of the parent's heap) and still flushes the standard output it sets up below.
-    import gc; gc.freeze()
-    cases = json.loads(sys.argv[1])
-    found = []
-    for argv, mode in cases:
-        read, write = os.pipe()
-        pid = os.fork()
-        if pid == 0:
-            os.close(read)
-            os.dup2(write, 2)
-            sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), write_through=True)
-            if mode == "closed":
-                os.close(1)
-                sys.stdout = None
-            else:
-                full = os.open("/dev/full", os.O_WRONLY)
-                os.dup2(full, 1)
-                if mode == "unbuffered":  # as python -u or PYTHONUNBUFFERED=1 make it
-                    raw = open(1, "wb", buffering=0, closefd=False)
-                    sys.stdout = io.TextIOWrapper(raw, write_through=True)
-                else:  # a file: block-buffered, flushed at exit
-                    sys.stdout = open(1, "w", closefd=False)
-            sys.exit(main(argv))  # as the console script: the interpreter exits here
-        os.close(write)
-        with os.fdopen(read, "rb") as pipe:
-            err = pipe.read().decode(errors="replace")
-        _, status = os.waitpid(pid, 0)
-        found.append([argv, mode, os.waitstatus_to_exitcode(status), err])
+    gc.freeze()
+    found += run(heavy)
     print(json.dumps(found))
     """
 )
 
 
-def run_cases(cases: list[tuple[list[str], str]]) -> list[tuple[list[str], str, int, str]]:
-    done = subprocess.run(
-        [sys.executable, "-c", DRIVER, json.dumps(cases)], capture_output=True, text=True
-    )
+Cases = list[tuple[list[str], str]]
+
+
+def run_cases(bare: Cases, light: Cases, heavy: Cases) -> list[tuple[list[str], str, int, str]]:
+    """Each case's (argv, mode, exit code, standard error): ``bare``, cases that import
+    nothing past the entry point, run first; then ``light``, those that need no more than
+    the commands' parsers and the plug-ins; then ``heavy``, the rest."""
+    cases = json.dumps([bare, light, heavy])
+    done = subprocess.run([sys.executable, "-c", DRIVER, cases], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     return [tuple(case) for case in json.loads(done.stdout)]
 
@@ -136,10 +154,17 @@ def test_every_command_on_a_full_or_closed_standard_output_is_one_line(quick_rep
     # every command of the table is among them (a new command must be added here)
     assert {argv[0] for argv in every if not argv[0].startswith("-")} == {c.name for c in COMMANDS}
     cheap = [argv for argv in every if argv[0] in ("--version", "--help", "presets", "plugins")]
-    cases = [(argv, "buffered") for argv in every]
-    cases += [(argv, "unbuffered") for argv in [*cheap, every[7], every[8]]]
-    cases += [(argv, "closed") for argv in every]
-    for argv, mode, code, err in run_cases(cases):
+    both = ("buffered", "unbuffered")
+    bare = [(argv, mode) for argv in cheap if argv[0].startswith("-") for mode in both]
+    light = [(argv, mode) for argv in cheap if not argv[0].startswith("-") for mode in both]
+    # A closed one is refused by main before it reads its arguments (cli/__init__.py), so
+    # the same for every command: one case per way in (argparse's own exits, a command,
+    # the one with the most work to refuse), each importing nothing
+    closed = [argv for argv in every if argv[0] in ("--version", "--help", "reproduce")]
+    bare += [(argv, "closed") for argv in [*closed, every[7]]]
+    heavy = [(argv, "buffered") for argv in every if argv not in cheap]
+    heavy += [(argv, "unbuffered") for argv in (every[7], every[8])]
+    for argv, mode, code, err in run_cases(bare, light, heavy):
         assert code == 2, (argv, mode, code, err)
         assert err.count("\n") == 1 and err.startswith("plateimpact: error: standard output"), (
             argv,
