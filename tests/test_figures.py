@@ -228,10 +228,12 @@ def run_cli(argv):
 
 @pytest.fixture(scope="module")
 def archive(tmp_path_factory):
+    """A study at two obliquities: its figure has two panels, the fewest drawn at the
+    page width (one panel is one column wide)."""
     path = tmp_path_factory.mktemp("figures") / "a.h5"
-    pi.Study.grid(
-        "t318", ["2024-T3/3.18"], [0, 30, 45, 60], SPEEDS[::3], pi.Variant("plugging")
-    ).run(archive=path)
+    pi.Study.grid("t318", ["2024-T3/3.18"], [0, 45], SPEEDS[::3], pi.Variant("plugging")).run(
+        archive=path
+    )
     return path
 
 
@@ -253,7 +255,7 @@ def test_dpi_sets_the_pixels_of_a_journal_width_figure(archive, tmp_path):
         assert height == pytest.approx(sizes[100][1] * dpi / 100, abs=1)
 
 
-def test_every_figure_flag_takes_its_dpi(archive, tmp_path):
+def test_every_figure_flag_takes_its_dpi(tmp_path):
     """A figure without a layout engine is cropped to what is drawn, so its pixels are
     not dpi x inches: twice the dpi gives about twice the pixels in each direction."""
     sizes = {}
