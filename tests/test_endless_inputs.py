@@ -7,6 +7,7 @@ opened; a pipe from the shell is read as a file is."""
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import subprocess
 import sys
@@ -92,20 +93,39 @@ def test_a_device_shipped_as_an_input_file_is_one_line(flag):
     assert_one_line(code, err, "a device, not a file")
 
 
-@pytest.mark.parametrize("flag", FIFO_FLAGS)
-def test_a_named_pipe_shipped_as_an_input_file_is_one_line_never_a_wait(tmp_path, flag):
-    """A tarball can hold a FIFO named like a shot or plate file; opening it for reading
-    would wait for a writer forever. It is refused before the open, in one line. (The
-    command runs in a child: were it to wait, the timeout, which a passing run never
-    comes near, turns the hang into a failure rather than a stuck suite.)"""
-    fifo = tmp_path / "shots.csv"
+#: Runs each command line of argv[2] (JSON: {flag: argv}) with ``run_cli`` of
+#: tests/test_output_files.py (argv[1] on sys.path), then prints {flag: [code, stderr]}.
+EACH_COMMAND = """
+import json, sys
+sys.path.insert(0, sys.argv[1])
+from test_output_files import run_cli
+found = {flag: run_cli(argv) for flag, argv in json.loads(sys.argv[2]).items()}
+print(json.dumps({flag: [code, err] for flag, (code, _, err) in found.items()}))
+"""
+
+
+@pytest.fixture(scope="module")
+def fifo_refusals(tmp_path_factory) -> dict[str, list]:
+    """{flag: [exit code, standard error]} of each FIFO_FLAGS command given a named pipe,
+    all run in one child (were one to wait, the timeout, which a passing run never comes
+    near, turns the hang into a failure rather than a stuck suite)."""
+    fifo = tmp_path_factory.mktemp("fifo") / "shots.csv"
     os.mkfifo(fifo)
-    argv = [arg.replace("{}", str(fifo)) for arg in FIFO_FLAGS[flag]]
+    commands = {
+        flag: [arg.replace("{}", str(fifo)) for arg in argv] for flag, argv in FIFO_FLAGS.items()
+    }
     done = subprocess.run(
-        [sys.executable, "-m", "plateimpact.cli", *argv], capture_output=True, text=True,
-        timeout=120,
+        [sys.executable, "-c", EACH_COMMAND, str(Path(__file__).parent), json.dumps(commands)],
+        capture_output=True, text=True, timeout=120, check=True,
     )  # fmt: skip
-    assert_one_line(done.returncode, done.stderr, "a named pipe (FIFO)")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("flag", FIFO_FLAGS)
+def test_a_named_pipe_shipped_as_an_input_file_is_one_line_never_a_wait(fifo_refusals, flag):
+    """A tarball can hold a FIFO named like a shot or plate file; opening it for reading
+    would wait for a writer forever. It is refused before the open, in one line."""
+    assert_one_line(*fifo_refusals[flag], "a named pipe (FIFO)")
 
 
 def test_a_pipe_from_the_shell_is_read(tmp_path):

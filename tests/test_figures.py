@@ -35,6 +35,12 @@ def eight_obliquities():
     return study.run()
 
 
+@pytest.fixture(scope="module")
+def eight_panels(eight_obliquities):
+    """The figure of ``eight_obliquities``, drawn once: the tests only read it."""
+    return exit_curves.plot_study(eight_obliquities)
+
+
 def panels_of(fig):
     """{title: (speed axes, obliquity axes, strip axes)}: each panel's axes, top to bottom."""
     axes = fig.axes
@@ -69,8 +75,8 @@ def test_the_panels_form_a_grid_of_at_most_four_columns(count):
     assert fig.get_size_inches()[0] == pytest.approx(3.5 if count == 1 else 7.2)
 
 
-def test_the_key_names_every_run_and_every_outcome_present(eight_obliquities):
-    fig = exit_curves.plot_study(eight_obliquities)
+def test_the_key_names_every_run_and_every_outcome_present(eight_obliquities, eight_panels):
+    fig = eight_panels
     (legend,) = fig.legends
     labels = [text.get_text() for text in legend.get_texts()]
     assert labels[:2] == ["plugging", "intact"]
@@ -93,10 +99,10 @@ def key_colours(legend):
     }
 
 
-def test_the_family_key_and_the_outcome_maps_share_one_palette(eight_obliquities):
+def test_the_family_key_and_the_outcome_maps_share_one_palette(eight_panels):
     from plateimpact.figures.limits_and_maps import plot_bands  # noqa: PLC0415
 
-    family = key_colours(exit_curves.plot_study(eight_obliquities).legends[0])
+    family = key_colours(eight_panels.legends[0])
     found = pi.limits.along_speed(
         pi.Simulation.from_names(), pi.presets.DEFAULT_SPHERE,
         pi.presets.plate("2024-T3/3.18"), np.radians([0.0, 60.0]), resolution=40.0,
@@ -133,10 +139,10 @@ def test_the_bands_key_names_each_limit_mark_and_sits_clear_of_the_axis_label():
     assert key_box.y1 <= label_box.y0  # below the x label, not over it
 
 
-def test_no_line_joins_two_outcomes_and_embedments_are_not_lines(eight_obliquities):
+def test_no_line_joins_two_outcomes_and_embedments_are_not_lines(eight_obliquities, eight_panels):
     results = eight_obliquities
     runs = list(results.runs)
-    fig = exit_curves.plot_study(results)
+    fig = eight_panels
     drawn = 0
     for ob in EIGHT:
         speed_ax, obliquity_ax, _ = panels_of(fig)[f"2024-T3/3.18, {ob}°"]
@@ -172,9 +178,9 @@ def test_exit_curves_break_at_every_regime_change():
     assert [line.get_label() for line in axes[0].get_lines()].count("run") == 1
 
 
-def test_the_strips_show_every_runs_outcome_at_every_scene(eight_obliquities):
+def test_the_strips_show_every_runs_outcome_at_every_scene(eight_obliquities, eight_panels):
     results = eight_obliquities
-    fig = exit_curves.plot_study(results)
+    fig = eight_panels
     for ob in (0, 30, 60):
         strip = panels_of(fig)[f"2024-T3/3.18, {ob}°"][2]
         index = panel_scenes(results, ob)
@@ -194,9 +200,9 @@ def test_the_strips_show_every_runs_outcome_at_every_scene(eight_obliquities):
 
 
 def test_normal_incidence_says_what_the_obliquity_is_instead_of_a_flat_line(
-    eight_obliquities,
+    eight_obliquities, eight_panels
 ):
-    fig = exit_curves.plot_study(eight_obliquities)
+    fig = eight_panels
     _, obliquity_ax, _ = panels_of(fig)["2024-T3/3.18, 0°"]
     assert not curve_lines(obliquity_ax)
     (note,) = obliquity_ax.texts
@@ -228,10 +234,12 @@ def run_cli(argv):
 
 @pytest.fixture(scope="module")
 def archive(tmp_path_factory):
+    """A study at two obliquities: its figure has two panels, the fewest drawn at the
+    page width (one panel is one column wide)."""
     path = tmp_path_factory.mktemp("figures") / "a.h5"
-    pi.Study.grid(
-        "t318", ["2024-T3/3.18"], [0, 30, 45, 60], SPEEDS[::3], pi.Variant("plugging")
-    ).run(archive=path)
+    pi.Study.grid("t318", ["2024-T3/3.18"], [0, 45], SPEEDS[::3], pi.Variant("plugging")).run(
+        archive=path
+    )
     return path
 
 
@@ -253,7 +261,7 @@ def test_dpi_sets_the_pixels_of_a_journal_width_figure(archive, tmp_path):
         assert height == pytest.approx(sizes[100][1] * dpi / 100, abs=1)
 
 
-def test_every_figure_flag_takes_its_dpi(archive, tmp_path):
+def test_every_figure_flag_takes_its_dpi(tmp_path):
     """A figure without a layout engine is cropped to what is drawn, so its pixels are
     not dpi x inches: twice the dpi gives about twice the pixels in each direction."""
     sizes = {}

@@ -151,13 +151,16 @@ def test_each_lines_limits_are_those_plateimpact_limits_names(bands, expected):
     assert found[:2] == pytest.approx(expected[:2], abs=0.05) and found[2:] == expected[2:]
 
 
-def test_limits_at_several_obliquities_are_each_obliquitys_alone(registry, at_30):
+def test_limits_at_several_obliquities_are_each_obliquitys_alone(registry):
     """One search over several obliquities gives each obliquity's limits bit for bit
-    (a line's scenes do not depend on the batch they run in)."""
-    spec = read_spec(oblique(60), registry)
+    (a line's scenes do not depend on the batch they run in, so a dozen samples show it
+    as well as many)."""
+    spec = read_spec(oblique(12), registry)
     both = sampled_limits_at(spec, registry, [0.0, 30.0])
-    assert np.array_equal(both[1].ballistic, at_30.ballistic)
-    assert np.array_equal(both[1].ricochet, at_30.ricochet)
+    alone = sampled_limits(spec, registry, 30.0)
+    assert np.all(np.isfinite(alone.ricochet))  # ricochet limits to compare at 30 deg
+    assert np.array_equal(both[1].ballistic, alone.ballistic)
+    assert np.array_equal(both[1].ricochet, alone.ricochet)
     alone = sampled_limits(spec, registry, 0.0)
     assert np.array_equal(both[0].ballistic, alone.ballistic)
 

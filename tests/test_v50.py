@@ -162,10 +162,12 @@ def test_the_bootstrap_agrees_with_the_profile_on_many_shots():
         resampled = np.array(getattr(fit, f"{name}_bootstrap_ci_m_s"))
         width = profile[1] - profile[0]
         np.testing.assert_allclose(resampled, profile, atol=0.2 * width, err_msg=name)
-    again = fit_v50(speed, perforated, bootstrap=400, rng=3)
-    assert again.v50_bootstrap_ci_m_s == fit.v50_bootstrap_ci_m_s
-    other = fit_v50(speed, perforated, bootstrap=400, rng=4)
-    assert other.v50_bootstrap_ci_m_s != fit.v50_bootstrap_ci_m_s
+    # The draws are the seed's whatever their number: fifty show it as well as 400.
+    few = fit_v50(speed, perforated, bootstrap=50, rng=3)
+    again = fit_v50(speed, perforated, bootstrap=50, rng=3)
+    assert again.v50_bootstrap_ci_m_s == few.v50_bootstrap_ci_m_s
+    other = fit_v50(speed, perforated, bootstrap=50, rng=4)
+    assert other.v50_bootstrap_ci_m_s != few.v50_bootstrap_ci_m_s
 
 
 def test_bootstrap_resamples_that_separate_enter_as_a_step():

@@ -174,11 +174,12 @@ def test_the_shipped_go_no_go_example_is_synthetic_and_centred_on_the_model():
     normal = groups[0.0]
     v, y = normal.impact_speed, normal.perforated
 
-    def nll(sigma: float, v10: float = 1.0) -> float:
+    def nll(sigma: np.ndarray, v10: float = 1.0) -> np.ndarray:
+        """At each σ of a column: the 4000 of the grid at once, not one call each."""
         z = (v - (v10 - sigma * stats.norm.ppf(0.1))) / sigma
-        return -np.sum(np.where(y, stats.norm.logcdf(z), stats.norm.logcdf(-z)))
+        return -np.sum(np.where(y, stats.norm.logcdf(z), stats.norm.logcdf(-z)), axis=-1)
 
-    profile = min(nll(s) for s in np.geomspace(1.0, 1e4, 4000))
+    profile = nll(np.geomspace(1.0, 1e4, 4000)[:, np.newaxis]).min()
     assert 2 * (profile + fits[0].log_likelihood) < stats.chi2.ppf(0.95, 1)
     assert fits[0].v10_ci_m_s[0] is None and fits[0].v10_ci_m_s[1] is not None
 
