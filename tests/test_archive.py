@@ -12,7 +12,7 @@ import sys
 import h5py
 import numpy as np
 import pytest
-from test_archive_writers import forked
+from forking import forked
 
 import plateimpact as pi
 import plateimpact.run.simulation

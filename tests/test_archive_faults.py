@@ -2,7 +2,7 @@
 full one is a plain one-line error, never a crash), an upgrade holds the lock and
 completes when rerun after a kill at any stage, and names too long or a read-only
 filesystem are one line naming the flag, before any work. Kills are deterministic:
-a forked writer SIGKILLs itself at a named fault point (test_archive_writers.forked)."""
+a forked writer SIGKILLs itself at a named fault point (forking.forked)."""
 
 from __future__ import annotations
 
@@ -18,8 +18,8 @@ import h5py
 import numpy as np
 import pytest
 import xarray as xr
+from forking import forked
 from test_archive import assert_same
-from test_archive_writers import forked
 from test_output_files import assert_one_line, mounted, run_cli
 from test_output_flags import CALIBRATE, SCENE
 

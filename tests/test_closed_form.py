@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import EVERY_INTEGRATOR
+from conftest import COARSE_STEPS, EVERY_INTEGRATOR
 from scipy.optimize import brentq
 
 import plateimpact as pi
@@ -68,7 +68,7 @@ def test_error_shrinks_at_first_order(sphere):
 def test_normal_incidence_stays_on_the_normal(sphere, integrator, docs_registry):
     # θ = 0 exactly: no lift, so no lateral motion at all, through failure and perforation.
     # Exact zeros at any step: the fixed-step integrators at 10 and 5 times their defaults.
-    coarse = {"segment": {"step": 1e-2}, "rk4": {"step": 5e-2}}.get(integrator, {})
+    coarse = COARSE_STEPS.get(integrator, {})
     simulation = pi.Simulation.from_names(
         integrator=integrator, registry=docs_registry, integrator_settings=coarse
     )

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_archive_writers import debris, forked
+from forking import forked
+from test_archive_writers import debris
 
 import plateimpact as pi
 import plateimpact.run.simulation

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import EVERY_INTEGRATOR
+from conftest import COARSE_STEPS, EVERY_INTEGRATOR
 from scipy.optimize import brentq
 
 import plateimpact as pi
@@ -127,23 +127,17 @@ def test_stepping_across_or_onto_branch_surfaces_meets_the_targets(failure, scen
         assert np.degrees(np.max(turn_error)) <= 1e-4
 
 
-#: Settings of the fixed-step integrators where a claim holds at any step (events located
-#: on the dense output, exact zeros): steps 10 and 5 times their defaults, at which the
-#: scenes above still end in the reference's outcomes (the segment method's first
-#: differs at 5e-2: the embedment after failure perforates).
-COARSE = {"segment": {"step": 1e-2}, "rk4": {"step": 5e-2}}
-
-
 @pytest.mark.parametrize("integrator", EVERY_INTEGRATOR)
 def test_events_are_located_on_their_surfaces(integrator, scenes, reference, docs_registry):
     # Failure starts at P = P*, rest is reached at V = f·Vs, a ricochet leaves where the
     # contact-lost margin is zero: events are located, not stepped over, whatever the
     # integrator (the driver locates them on its dense output) and its step. And the
-    # outcomes are the reference's.
+    # outcomes are the reference's (at COARSE_STEPS still: the segment method's first
+    # differs at 5e-2, where the embedment after failure perforates).
     simulation = pi.Simulation.from_names(
         integrator=integrator,
         registry=docs_registry,
-        integrator_settings=COARSE.get(integrator, {}),
+        integrator_settings=COARSE_STEPS.get(integrator, {}),
     )
     result = simulation.run_batch(scenes, record_trajectory=True)
     np.testing.assert_array_equal(result.outcome, reference.outcome)

@@ -12,9 +12,10 @@ import attrs
 import h5py
 import numpy as np
 import pytest
+from forking import forked
 from old_records import to_old_layout
 from test_archive import flip_bytes
-from test_archive_writers import STAGES, archive_maker, debris, forked
+from test_archive_writers import STAGES, archive_maker, debris
 from test_limits import ESTAR, E, P
 from test_output_files import assert_one_line, run_cli
 

@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import EVERY_INTEGRATOR, sweep
+from conftest import COARSE_STEPS, EVERY_INTEGRATOR, sweep
 
 import plateimpact as pi
 from plateimpact import presets
@@ -47,7 +47,7 @@ def test_obliquity_is_held_at_180_once_within_the_tolerance(sphere, integrator, 
     # The fixed-step integrators at 10 and 5 times their default steps: the hold starts
     # on the located event, so where it starts does not depend on the step (π − θ there
     # is the same to 16 digits at segment steps 1e-3 to 5e-2 and rk4 steps 1e-2 to 0.1).
-    coarse = {"segment": {"step": 1e-2}, "rk4": {"step": 5e-2}}.get(integrator, {})
+    coarse = COARSE_STEPS.get(integrator, {})
     simulation = pi.Simulation.from_names(
         integrator=integrator, registry=docs_registry, integrator_settings=coarse
     )
